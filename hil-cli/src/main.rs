@@ -1,0 +1,45 @@
+//! `hil`: run human-in-the-loop contextual-bandit experiments.
+
+mod cmd;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Human-in-the-loop contextual bandits for assistive robotics.
+///
+/// A robot chooses an action for each item (a food piece on a plate) or asks
+/// the person it serves, trading task success against querying workload.
+/// Bundled data is synthetic, calibrated to published figures.
+#[derive(Debug, Parser)]
+#[command(name = "hil", version, about, long_about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run an experiment described by a TOML config.
+    Run(cmd::run::RunArgs),
+}
+
+fn main() -> ExitCode {
+    // Keep the built-in component crates linked so their typetag
+    // registrations are present in the binary.
+    hil_policies::link();
+    hil_workload::link();
+    hil_envs::link();
+    hil_kinova_mujoco::link();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(args) => cmd::run::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

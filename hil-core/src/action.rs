@@ -1,0 +1,116 @@
+//! Robot actions (arms) and the named action space of a task.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{HilError, Result};
+
+/// Index of a robot action in an [`ActionSpace`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct ArmId(pub usize);
+
+impl ArmId {
+    /// The index as `usize`.
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
+
+impl std::fmt::Display for ArmId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+/// The named robot actions of a task (not including the query action).
+///
+/// ```
+/// use hil_core::{ActionSpace, ArmId};
+/// let space = ActionSpace::feeding();
+/// assert_eq!(space.len(), 6);
+/// assert_eq!(space.name(ArmId(4)).unwrap(), "TA0");
+/// assert_eq!(space.find("TV90"), Some(ArmId(3)));
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ActionSpace {
+    names: Vec<String>,
+}
+
+/// The six skewering actions of the feeding task: pitch (vertical skewer,
+/// tilted vertical, tilted angled) × roll (0° or 90° to the food's major axis).
+pub const FEEDING_ACTIONS: [&str; 6] = ["VS0", "VS90", "TV0", "TV90", "TA0", "TA90"];
+
+impl ActionSpace {
+    /// Builds an action space from unique, non-empty names.
+    pub fn new<S: Into<String>>(names: impl IntoIterator<Item = S>) -> Result<Self> {
+        let names: Vec<String> = names.into_iter().map(Into::into).collect();
+        if names.is_empty() {
+            return Err(HilError::invalid_input("action space", "it has no actions"));
+        }
+        for (i, n) in names.iter().enumerate() {
+            if n.trim().is_empty() {
+                return Err(HilError::invalid_input(
+                    format!("action name #{i}"),
+                    "it is empty",
+                ));
+            }
+            if names[..i].contains(n) {
+                return Err(HilError::invalid_input(
+                    format!("action name #{i}"),
+                    format!("`{n}` appears twice"),
+                ));
+            }
+        }
+        Ok(Self { names })
+    }
+
+    /// The feeding task's six actions, [`FEEDING_ACTIONS`].
+    pub fn feeding() -> Self {
+        Self {
+            names: FEEDING_ACTIONS.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    /// Number of robot actions.
+    pub fn len(&self) -> usize {
+        self.names.len()
+    }
+
+    /// Always false: an action space has at least one action.
+    pub fn is_empty(&self) -> bool {
+        self.names.is_empty()
+    }
+
+    /// All names, in arm order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The name of `arm`, or an error if it is out of range.
+    pub fn name(&self, arm: ArmId) -> Result<&str> {
+        self.check(arm)?;
+        Ok(&self.names[arm.0])
+    }
+
+    /// The arm with this name, if any.
+    pub fn find(&self, name: &str) -> Option<ArmId> {
+        self.names.iter().position(|n| n == name).map(ArmId)
+    }
+
+    /// Returns an error unless `arm` indexes this space.
+    pub fn check(&self, arm: ArmId) -> Result<()> {
+        if arm.0 < self.names.len() {
+            Ok(())
+        } else {
+            Err(HilError::ArmOutOfRange {
+                arm: arm.0,
+                n_arms: self.names.len(),
+            })
+        }
+    }
+
+    /// Iterates over all arms.
+    pub fn arms(&self) -> impl Iterator<Item = ArmId> + '_ {
+        (0..self.names.len()).map(ArmId)
+    }
+}

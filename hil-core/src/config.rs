@@ -1,0 +1,382 @@
+//! Experiment configuration: TOML files whose components are named by type
+//! through typetag, with errors that name the file, line and field.
+//!
+//! ```toml
+//! seed = 7
+//! episodes = 3
+//!
+//! [session]
+//! n_att = 10
+//! wl0 = 0.5
+//!
+//! [environment]
+//! type = "food_replay"     # any registered EnvironmentConfig
+//!
+//! [policy]
+//! type = "linucb_qg"
+//! alpha = 0.1
+//!
+//! [workload]               # the model that evolves and scores workload
+//! type = "granger"
+//!
+//! [channel]
+//! type = "simulated_expert"
+//! ```
+//!
+//! Crates register built-in types with `#[typetag::serde(name = "...")]` on
+//! an `impl PolicyConfig for ...` (or the other three config traits).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use crate::action::ActionSpace;
+use crate::channel::QueryChannel;
+use crate::environment::Environment;
+use crate::error::Result;
+use crate::policy::Policy;
+use crate::session::SessionSettings;
+use crate::workload::WorkloadModel;
+
+/// What a component factory may need to know about the experiment.
+#[derive(Clone, Debug)]
+pub struct BuildContext {
+    /// Directory relative paths in the config are resolved against.
+    pub base_dir: PathBuf,
+    /// The experiment seed.
+    pub seed: u64,
+    /// The environment's action space (known once the environment is built).
+    pub action_space: Option<ActionSpace>,
+    /// The environment's context dimension (known once it is built).
+    pub context_dim: Option<usize>,
+}
+
+impl BuildContext {
+    /// A context resolving paths against `base_dir`.
+    pub fn new(base_dir: impl Into<PathBuf>, seed: u64) -> Self {
+        Self {
+            base_dir: base_dir.into(),
+            seed,
+            action_space: None,
+            context_dim: None,
+        }
+    }
+
+    /// Resolves `path` against the config's directory unless it is absolute.
+    pub fn resolve(&self, path: &Path) -> PathBuf {
+        if path.is_absolute() {
+            path.to_path_buf()
+        } else {
+            self.base_dir.join(path)
+        }
+    }
+}
+
+/// A serialisable recipe for a [`Policy`].
+#[typetag::serde(tag = "type")]
+pub trait PolicyConfig: std::fmt::Debug + Send + Sync {
+    /// Validates the parameters and builds the policy for the environment
+    /// described by `ctx`.
+    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>>;
+}
+
+/// A serialisable recipe for an [`Environment`].
+#[typetag::serde(tag = "type")]
+pub trait EnvironmentConfig: std::fmt::Debug + Send + Sync {
+    /// Validates the parameters and builds the environment.
+    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Environment>>;
+}
+
+/// A serialisable recipe for a [`WorkloadModel`].
+#[typetag::serde(tag = "type")]
+pub trait WorkloadModelConfig: std::fmt::Debug + Send + Sync {
+    /// Validates the parameters and builds (or loads) the model.
+    fn build(&self, ctx: &BuildContext) -> Result<Arc<dyn WorkloadModel>>;
+}
+
+/// A serialisable recipe for a [`QueryChannel`].
+#[typetag::serde(tag = "type")]
+pub trait QueryChannelConfig: std::fmt::Debug + Send + Sync {
+    /// Validates the parameters and builds the channel.
+    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn QueryChannel>>;
+}
+
+/// A complete experiment: the components and how to run them.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentConfig {
+    /// Shared libraries to load before the components are built.
+    #[serde(default)]
+    pub plugins: Vec<PathBuf>,
+    /// Master seed; episode `k` runs with a seed derived from it.
+    #[serde(default)]
+    pub seed: u64,
+    /// Number of episodes (the policy keeps learning across them).
+    #[serde(default = "one")]
+    pub episodes: usize,
+    /// Session-loop settings.
+    #[serde(default)]
+    pub session: SessionSettings,
+    /// Where the robot acts.
+    pub environment: Box<dyn EnvironmentConfig>,
+    /// Who decides.
+    pub policy: Box<dyn PolicyConfig>,
+    /// The workload model that evolves and scores the person's workload.
+    pub workload: Box<dyn WorkloadModelConfig>,
+    /// The model the policy forecasts with, if different from `workload`.
+    #[serde(default)]
+    pub policy_workload: Option<Box<dyn WorkloadModelConfig>>,
+    /// How queries reach the expert.
+    pub channel: Box<dyn QueryChannelConfig>,
+}
+
+fn one() -> usize {
+    1
+}
+
+impl ExperimentConfig {
+    /// Reads and validates an experiment file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| crate::HilError::io("reading", path, e))?;
+        Ok(Self::parse(&text, path)?)
+    }
+
+    /// Parses experiment TOML; `path` is only used in error messages.
+    pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
+        let cfg: Self = parse_toml(text, path)?;
+        cfg.session
+            .validate()
+            .map_err(|e| ConfigError::at_key(text, path, &["session"], e.to_string()))?;
+        if cfg.episodes == 0 {
+            return Err(ConfigError::at_key(
+                text,
+                path,
+                &["episodes"],
+                "must be at least 1".into(),
+            ));
+        }
+        Ok(cfg)
+    }
+}
+
+/// A configuration error, located in its file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}:{line}:{column}: {}{message}", path.display(), field.as_ref().map(|f| format!("field `{f}`: ")).unwrap_or_default())]
+pub struct ConfigError {
+    /// The file at fault.
+    pub path: PathBuf,
+    /// 1-based line (0 if unknown).
+    pub line: usize,
+    /// 1-based column (0 if unknown).
+    pub column: usize,
+    /// Dotted path of the field at fault, e.g. `policy.alpha`.
+    pub field: Option<String>,
+    /// What is wrong.
+    pub message: String,
+}
+
+/// Parses TOML into `T`, turning errors into located [`ConfigError`]s.
+pub fn parse_toml<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &Path,
+) -> std::result::Result<T, ConfigError> {
+    toml::from_str(text).map_err(|e| ConfigError::from_toml(text, path, &e))
+}
+
+impl ConfigError {
+    fn from_toml(text: &str, path: &Path, e: &toml::de::Error) -> Self {
+        let message = e.message().trim().to_string();
+        let span_start = e.span().map(|s| s.start);
+        // Name the field: serde names it for unknown/missing fields; otherwise
+        // the span points at a key or value whose key we read from the text.
+        let named = quoted_after(&message, "unknown field `")
+            .or_else(|| quoted_after(&message, "missing field `"));
+        let (mut line, mut column) = span_start.map_or((0, 0), |s| line_col(text, s));
+        let section = span_start.map(|s| section_at(text, s)).unwrap_or_default();
+        let field = match (&named, span_start) {
+            (Some(name), _) => {
+                // typetag buffers a table and reports at its header: find the key.
+                if let Some(l) = find_key_line(text, &section, name) {
+                    line = l;
+                    column = 1;
+                }
+                Some(join_path(&section, name))
+            }
+            (None, Some(s)) => match key_on_line(text, s) {
+                Some(k) => Some(join_path(&section, &k)),
+                // typetag buffers a table and reports a bad value at the table
+                // header: find the key in the section whose value is the one
+                // the message quotes.
+                None => match offending_literal(&message)
+                    .and_then(|lit| find_value_line(text, &section, &lit))
+                {
+                    Some((l, key)) => {
+                        line = l;
+                        column = 1;
+                        Some(join_path(&section, &key))
+                    }
+                    None => (!section.is_empty()).then(|| section.join(".")),
+                },
+            },
+            (None, None) => None,
+        };
+        if message.starts_with("unknown variant") && field.is_none() {
+            column = column.max(1);
+        }
+        Self {
+            path: path.to_path_buf(),
+            line,
+            column,
+            field,
+            message,
+        }
+    }
+
+    /// An error about the key at `key_path` (e.g. `["policy", "alpha"]`).
+    pub fn at_key(text: &str, path: &Path, key_path: &[&str], message: String) -> Self {
+        let (section, key) = match key_path.split_last() {
+            Some((k, s)) => (s.iter().map(|s| s.to_string()).collect::<Vec<_>>(), *k),
+            None => (Vec::new(), ""),
+        };
+        let line = find_key_line(text, &section, key)
+            .or_else(|| find_header_line(text, key_path))
+            .unwrap_or(0);
+        Self {
+            path: path.to_path_buf(),
+            line,
+            column: if line > 0 { 1 } else { 0 },
+            field: Some(key_path.join(".")),
+            message,
+        }
+    }
+}
+
+fn quoted_after(msg: &str, prefix: &str) -> Option<String> {
+    let rest = &msg[msg.find(prefix)? + prefix.len()..];
+    Some(rest[..rest.find('`')?].to_string())
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rfind('\n').map_or(offset, |p| offset - p - 1) + 1;
+    (line, column)
+}
+
+/// The `[a.b]` section in force at byte `offset`.
+fn section_at(text: &str, offset: usize) -> Vec<String> {
+    let mut section = Vec::new();
+    let mut pos = 0;
+    for raw in text.split_inclusive('\n') {
+        if pos > offset {
+            break;
+        }
+        if let Some(h) = header_of(raw) {
+            section = h;
+        }
+        pos += raw.len();
+    }
+    section
+}
+
+fn header_of(line: &str) -> Option<Vec<String>> {
+    let l = line.trim();
+    let inner = l
+        .strip_prefix("[[")
+        .and_then(|r| r.split("]]").next())
+        .or_else(|| l.strip_prefix('[').and_then(|r| r.split(']').next()))?;
+    Some(
+        inner
+            .split('.')
+            .map(|s| s.trim().trim_matches('"').to_string())
+            .collect(),
+    )
+}
+
+fn key_of(line: &str) -> Option<String> {
+    let l = line.trim_start();
+    if l.starts_with('#') || l.starts_with('[') {
+        return None;
+    }
+    let eq = l.find('=')?;
+    let key = l[..eq].trim().trim_matches('"');
+    (!key.is_empty()).then(|| key.to_string())
+}
+
+fn key_on_line(text: &str, offset: usize) -> Option<String> {
+    let offset = offset.min(text.len());
+    let start = text[..offset].rfind('\n').map_or(0, |p| p + 1);
+    let end = text[offset..].find('\n').map_or(text.len(), |p| offset + p);
+    key_of(&text[start..end])
+}
+
+fn find_key_line(text: &str, section: &[String], key: &str) -> Option<usize> {
+    let mut current: Vec<String> = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        if let Some(h) = header_of(raw) {
+            current = h;
+            continue;
+        }
+        if current == section && key_of(raw).as_deref() == Some(key) {
+            return Some(i + 1);
+        }
+    }
+    None
+}
+
+/// The literal a serde "invalid type/value" message quotes, as it would be
+/// written in TOML: `string "two"` gives `"two"`, `integer `5`` gives `5`.
+fn offending_literal(msg: &str) -> Option<String> {
+    let rest = msg
+        .strip_prefix("invalid type: ")
+        .or_else(|| msg.strip_prefix("invalid value: "))?;
+    if let Some(r) = rest.strip_prefix("string \"") {
+        return Some(format!("\"{}\"", &r[..r.find('"')?]));
+    }
+    let start = rest.find('`')? + 1;
+    let end = start + rest[start..].find('`')?;
+    Some(rest[start..end].to_string())
+}
+
+fn find_value_line(text: &str, section: &[String], literal: &str) -> Option<(usize, String)> {
+    let mut current: Vec<String> = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        if let Some(h) = header_of(raw) {
+            current = h;
+            continue;
+        }
+        if current != section {
+            continue;
+        }
+        let Some(key) = key_of(raw) else { continue };
+        let value = raw[raw.find('=')? + 1..]
+            .split('#')
+            .next()
+            .unwrap_or("")
+            .trim();
+        let normalised = value.replace('\'', "\"");
+        if value == literal || normalised == literal {
+            return Some((i + 1, key));
+        }
+    }
+    None
+}
+
+fn find_header_line(text: &str, section: &[&str]) -> Option<usize> {
+    text.lines()
+        .position(|raw| {
+            header_of(raw).is_some_and(|h| h.iter().map(String::as_str).eq(section.iter().copied()))
+        })
+        .map(|i| i + 1)
+}
+
+fn join_path(section: &[String], key: &str) -> String {
+    if section.is_empty() {
+        key.to_string()
+    } else {
+        format!("{}.{key}", section.join("."))
+    }
+}

@@ -1,0 +1,164 @@
+//! The one error type every trait method returns.
+//!
+//! Variants are structured (like faer's errors) so that callers can react to
+//! the kind of failure, and every message names what was wrong and where.
+
+use std::path::PathBuf;
+
+/// Result alias used across hil.
+pub type Result<T, E = HilError> = std::result::Result<T, E>;
+
+/// Errors raised by hil components.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum HilError {
+    /// A value handed to a component is outside what it accepts.
+    #[error("invalid {what}: {why}")]
+    InvalidInput {
+        /// The value at fault, e.g. `context[3]` or `arm`.
+        what: String,
+        /// Why it was rejected, including the offending value.
+        why: String,
+    },
+    /// A context has the wrong dimension.
+    #[error("context dimension mismatch: expected {expected}, got {got}")]
+    DimensionMismatch {
+        /// Dimension the component was built for.
+        expected: usize,
+        /// Dimension it received.
+        got: usize,
+    },
+    /// An arm index is not in the action space.
+    #[error("arm {arm} is out of range: the action space has {n_arms} arms")]
+    ArmOutOfRange {
+        /// The offending arm index.
+        arm: usize,
+        /// Number of arms available.
+        n_arms: usize,
+    },
+    /// A hyperparameter or configuration value failed validation.
+    #[error("invalid parameter `{name}` = {value}: {why}")]
+    InvalidParameter {
+        /// Parameter name as it appears in configs.
+        name: String,
+        /// The rejected value, rendered.
+        value: String,
+        /// The rule it broke.
+        why: String,
+    },
+    /// A configuration file could not be parsed or validated.
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
+    /// Reading or writing a file failed.
+    #[error("{op} {}: {source}", path.display())]
+    Io {
+        /// What was being done (`reading`, `writing`, ...).
+        op: &'static str,
+        /// The file concerned.
+        path: PathBuf,
+        /// The underlying I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A data file is malformed.
+    #[error("{}:{record}: field `{field}`: {why}", path.display())]
+    Data {
+        /// The file at fault.
+        path: PathBuf,
+        /// Line or record number (1-based) at fault.
+        record: usize,
+        /// Column or field at fault.
+        field: String,
+        /// What is wrong with it.
+        why: String,
+    },
+    /// (De)serialising state or parameters failed.
+    #[error("serialisation of {what} failed: {why}")]
+    Serde {
+        /// What was being (de)serialised.
+        what: String,
+        /// The underlying message.
+        why: String,
+    },
+    /// A component is in a state where the call makes no sense
+    /// (e.g. `execute` before `next_item`).
+    #[error("{component}: {why}")]
+    State {
+        /// The component that refused.
+        component: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// A human (or channel) failed in a way the session cannot recover from.
+    #[error("query channel `{channel}` failed: {why}")]
+    Channel {
+        /// Channel name.
+        channel: String,
+        /// What happened.
+        why: String,
+    },
+    /// A simulator or external backend failed (diverged, crashed, missing library).
+    #[error("backend `{backend}` failed: {why}")]
+    Backend {
+        /// Backend name.
+        backend: String,
+        /// What happened.
+        why: String,
+    },
+    /// A plugin failed to load, handshake or run.
+    #[error("plugin {}: {why}", path.display())]
+    Plugin {
+        /// The shared library concerned.
+        path: PathBuf,
+        /// What happened.
+        why: String,
+    },
+}
+
+impl HilError {
+    /// Shorthand for [`HilError::InvalidInput`].
+    pub fn invalid_input(what: impl Into<String>, why: impl Into<String>) -> Self {
+        Self::InvalidInput {
+            what: what.into(),
+            why: why.into(),
+        }
+    }
+
+    /// Shorthand for [`HilError::InvalidParameter`].
+    pub fn invalid_parameter(
+        name: impl Into<String>,
+        value: impl std::fmt::Display,
+        why: impl Into<String>,
+    ) -> Self {
+        Self::InvalidParameter {
+            name: name.into(),
+            value: value.to_string(),
+            why: why.into(),
+        }
+    }
+
+    /// Shorthand for [`HilError::State`].
+    pub fn state(component: impl Into<String>, why: impl Into<String>) -> Self {
+        Self::State {
+            component: component.into(),
+            why: why.into(),
+        }
+    }
+
+    /// Shorthand for [`HilError::Serde`].
+    pub fn serde(what: impl Into<String>, why: impl std::fmt::Display) -> Self {
+        Self::Serde {
+            what: what.into(),
+            why: why.to_string(),
+        }
+    }
+
+    /// Shorthand for [`HilError::Io`].
+    pub fn io(op: &'static str, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Self::Io {
+            op,
+            path: path.into(),
+            source,
+        }
+    }
+}

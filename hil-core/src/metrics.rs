@@ -1,0 +1,151 @@
+//! The paper's episode metrics, defined once for every environment.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{HilError, Result};
+use crate::session::StepEvent;
+
+/// Metrics of one episode.
+///
+/// Definitions (T = number of timesteps, I = number of items):
+/// - `r_task_avg` = (1/T) Σ_t r_task(x_t, a_t), where r_task is the executed
+///   action's success probability when the environment knows it, else the
+///   0/1 outcome;
+/// - `delta_wl` = WL_T − WL_0 (the tracked workload after the last step);
+/// - `t_conv` = mean number of timesteps spent per item (attempts until
+///   success, or N_att for an item never acquired);
+/// - `f_q` = fraction of items at which at least one query was asked;
+/// - `f_fail_food` = fraction of items never acquired;
+/// - `f_auto_food` = fraction of items acquired without any query;
+/// - `n_success` = number of items acquired; `n_q` = number of query steps.
+///
+/// `M_wt(w_task)` = w_task·r_task_avg − (1 − w_task)·ΔWL is [`EpisodeMetrics::m_wt`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EpisodeMetrics {
+    /// Mean task reward per timestep.
+    pub r_task_avg: f64,
+    /// Initial workload WL_0.
+    pub wl0: f64,
+    /// Final workload WL_T.
+    pub wl_final: f64,
+    /// WL_T − WL_0.
+    pub delta_wl: f64,
+    /// Mean timesteps per item.
+    pub t_conv: f64,
+    /// Fraction of items with a query.
+    pub f_q: f64,
+    /// Fraction of items never acquired.
+    pub f_fail_food: f64,
+    /// Fraction of items acquired without a query.
+    pub f_auto_food: f64,
+    /// Items acquired.
+    pub n_success: usize,
+    /// Query steps.
+    pub n_q: usize,
+    /// Items presented.
+    pub n_items: usize,
+    /// Timesteps T.
+    pub n_steps: usize,
+}
+
+impl EpisodeMetrics {
+    /// Computes the metrics of an episode from its events, in order.
+    ///
+    /// ```
+    /// use hil_core::EpisodeMetrics;
+    /// let m = EpisodeMetrics::from_events(&[], 0.5).unwrap();
+    /// assert_eq!(m.n_steps, 0);
+    /// assert_eq!(m.delta_wl, 0.0);
+    /// assert!((m.m_wt(0.7) - 0.0).abs() < 1e-12);
+    /// ```
+    pub fn from_events(events: &[StepEvent], wl0: f64) -> Result<Self> {
+        let mut items: Vec<ItemTally> = Vec::new();
+        let mut r_sum = 0.0;
+        let mut n_q = 0;
+        for e in events {
+            let s = &e.step;
+            let new_item = items.last().is_none_or(|it| it.index != s.item_index);
+            if new_item {
+                if items.iter().any(|it| it.index == s.item_index) {
+                    return Err(HilError::invalid_input(
+                        format!("event at t = {}", s.t),
+                        format!("item {} reappears after another item", s.item_index),
+                    ));
+                }
+                items.push(ItemTally {
+                    index: s.item_index,
+                    ..ItemTally::default()
+                });
+            }
+            let it = items.last_mut().expect("pushed above");
+            it.steps += 1;
+            it.success |= e.outcome.success;
+            if s.decision.is_query() {
+                it.queried = true;
+                n_q += 1;
+            }
+            r_sum += e.task_reward();
+        }
+        let wl_final = events.last().map_or(wl0, |e| e.step.wl);
+        let n_items = items.len();
+        let frac = |pred: &dyn Fn(&ItemTally) -> bool| {
+            if n_items == 0 {
+                0.0
+            } else {
+                items.iter().filter(|it| pred(it)).count() as f64 / n_items as f64
+            }
+        };
+        let n_steps = events.len();
+        Ok(Self {
+            r_task_avg: if n_steps == 0 {
+                0.0
+            } else {
+                r_sum / n_steps as f64
+            },
+            wl0,
+            wl_final,
+            delta_wl: wl_final - wl0,
+            t_conv: if n_items == 0 {
+                0.0
+            } else {
+                n_steps as f64 / n_items as f64
+            },
+            f_q: frac(&|it| it.queried),
+            f_fail_food: frac(&|it| !it.success),
+            f_auto_food: frac(&|it| it.success && !it.queried),
+            n_success: items.iter().filter(|it| it.success).count(),
+            n_q,
+            n_items,
+            n_steps,
+        })
+    }
+
+    /// The surrogate objective M_wt = w_task·r_task_avg − (1 − w_task)·ΔWL.
+    pub fn m_wt(&self, w_task: f64) -> f64 {
+        w_task * self.r_task_avg - (1.0 - w_task) * self.delta_wl
+    }
+}
+
+#[derive(Debug, Default)]
+struct ItemTally {
+    index: usize,
+    steps: usize,
+    success: bool,
+    queried: bool,
+}
+
+/// Mean and (population) standard deviation of a sample, as the paper reports.
+///
+/// ```
+/// let (m, s) = hil_core::metrics::mean_std(&[1.0, 3.0]);
+/// assert_eq!((m, s), (2.0, 1.0));
+/// ```
+pub fn mean_std(xs: &[f64]) -> (f64, f64) {
+    if xs.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let n = xs.len() as f64;
+    let m = xs.iter().sum::<f64>() / n;
+    let v = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n;
+    (m, v.sqrt())
+}

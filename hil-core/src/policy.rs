@@ -1,0 +1,118 @@
+//! The [`Policy`] trait: decide to act or ask, and learn from outcomes.
+
+use serde_json::Value;
+
+use crate::action::ArmId;
+use crate::context::Context;
+use crate::decision::Decision;
+use crate::error::{HilError, Result};
+use crate::time::Timestep;
+use crate::workload::WorkloadForecast;
+
+/// What a policy knows when it decides.
+#[derive(Debug)]
+pub struct DecisionInput<'a> {
+    /// The context of the current observation.
+    pub context: &'a Context,
+    /// Session timestep (1-based).
+    pub t: Timestep,
+    /// Index of the current item in the episode (0-based).
+    pub item_index: usize,
+    /// Number of items seen before the current one (N in LinUCB-ExpDecay).
+    pub items_seen: usize,
+    /// Attempt number at the current item (0 = first timestep of this item).
+    pub attempt: u32,
+    /// Forecasts of the querying workload, for policies that weigh it.
+    pub workload: WorkloadForecast<'a>,
+}
+
+/// What a policy learns from after an attempt.
+#[derive(Clone, Copy, Debug)]
+pub struct Feedback<'a> {
+    /// The context the attempt was made in.
+    pub context: &'a Context,
+    /// The arm that was executed (the expert's after a query).
+    pub arm: ArmId,
+    /// The observed reward (1 on success, 0 otherwise).
+    pub reward: f64,
+    /// Session timestep of the attempt.
+    pub t: Timestep,
+    /// Whether the arm came from a human answer rather than the policy.
+    pub from_expert: bool,
+}
+
+/// A contextual-bandit policy with a query action.
+///
+/// Object-safe, no generics or associated types, so it can be named in
+/// configs through typetag and cross a plugin boundary.
+///
+/// Contract (checked by `hil_core::testing::check_policy`):
+/// - `decide` returns an arm in `0..n_arms()` (as `Act` or as a query's
+///   `fallback`) and errors on a context of the wrong dimension;
+/// - given the same seed and inputs, a policy makes the same decisions;
+/// - `restore(save())` gives a policy that continues identically.
+///
+/// The session loop calls `decide` only for attempts the policy owns: after a
+/// query, later attempts at the same item execute the expert's arm and the
+/// policy is only told about them through `observe`.
+pub trait Policy: Send {
+    /// Short name for logs (e.g. `linucb_qg`).
+    fn name(&self) -> &str;
+
+    /// Number of robot actions the policy chooses among.
+    fn n_arms(&self) -> usize;
+
+    /// Context dimension the policy expects.
+    fn dim(&self) -> usize;
+
+    /// Reseeds the policy's own randomness. Deterministic policies ignore it.
+    fn seed(&mut self, seed: u64) {
+        let _ = seed;
+    }
+
+    /// Decides what to do for the current observation.
+    fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision>;
+
+    /// Learns from the outcome of an executed attempt.
+    fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()>;
+
+    /// Serialises the full learning state (estimates, RNG state, counters).
+    fn save(&self) -> Result<Value> {
+        Err(HilError::state(
+            self.name(),
+            "this policy cannot checkpoint its state",
+        ))
+    }
+
+    /// Restores a state produced by [`Policy::save`] on a policy of the same type.
+    fn restore(&mut self, state: Value) -> Result<()> {
+        let _ = state;
+        Err(HilError::state(
+            self.name(),
+            "this policy cannot restore a checkpoint",
+        ))
+    }
+}
+
+/// Checks the parts of a [`DecisionInput`] every policy must validate.
+pub fn check_input(policy: &dyn Policy, input: &DecisionInput<'_>) -> Result<()> {
+    input.context.check_dim(policy.dim())
+}
+
+/// Checks the parts of a [`Feedback`] every policy must validate.
+pub fn check_feedback(policy: &dyn Policy, feedback: &Feedback<'_>) -> Result<()> {
+    feedback.context.check_dim(policy.dim())?;
+    if feedback.arm.0 >= policy.n_arms() {
+        return Err(HilError::ArmOutOfRange {
+            arm: feedback.arm.0,
+            n_arms: policy.n_arms(),
+        });
+    }
+    if !feedback.reward.is_finite() {
+        return Err(HilError::invalid_input(
+            "reward",
+            format!("{} is not finite", feedback.reward),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,177 @@
+//! Queries to the human and their responses.
+//!
+//! A query carries the paper's three query variables (response type,
+//! difficulty, distraction) so that the workload model sees exactly what was
+//! asked.
+
+use serde::{Deserialize, Serialize};
+
+use crate::action::{ActionSpace, ArmId};
+use crate::context::Context;
+use crate::environment::Item;
+use crate::time::Timestep;
+
+/// How the person answers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ResponseType {
+    /// Multiple choice (a semantic label or an action).
+    #[default]
+    Mcq,
+    /// Draw a bounding box around an item.
+    BoundingBox,
+    /// Free text, e.g. why an attempt failed.
+    OpenEnded,
+}
+
+/// How hard the question is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Difficulty {
+    /// Easy question.
+    #[default]
+    Easy,
+    /// Hard question.
+    Hard,
+}
+
+/// What else the person is doing when asked.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Distraction {
+    /// No concurrent task.
+    #[default]
+    None,
+    /// An easy concurrent task (e.g. simple additions).
+    Easy,
+    /// A hard concurrent task (e.g. transcribing a video).
+    Hard,
+}
+
+impl ResponseType {
+    /// All variants in one-hot order.
+    pub const ALL: [Self; 3] = [Self::Mcq, Self::BoundingBox, Self::OpenEnded];
+}
+impl Difficulty {
+    /// All variants in one-hot order.
+    pub const ALL: [Self; 2] = [Self::Easy, Self::Hard];
+}
+impl Distraction {
+    /// All variants in one-hot order.
+    pub const ALL: [Self; 3] = [Self::None, Self::Easy, Self::Hard];
+}
+
+/// The kind of a query: the variables that drive querying workload.
+///
+/// The default is the paper's simulation default: an easy multiple-choice
+/// question with no distraction.
+///
+/// ```
+/// use hil_core::{QueryKind, ResponseType, Difficulty, Distraction};
+/// let k = QueryKind::default();
+/// assert_eq!((k.response, k.difficulty, k.distraction),
+///            (ResponseType::Mcq, Difficulty::Easy, Distraction::None));
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct QueryKind {
+    /// How the person answers.
+    pub response: ResponseType,
+    /// How hard the question is.
+    pub difficulty: Difficulty,
+    /// What else the person is doing.
+    pub distraction: Distraction,
+}
+
+/// Everything a channel needs to pose one query.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Query {
+    /// Session timestep of the query.
+    pub t: Timestep,
+    /// The item the robot is working on.
+    pub item: Item,
+    /// The kind of question asked.
+    pub kind: QueryKind,
+    /// The robot actions the person may choose from.
+    pub actions: ActionSpace,
+    /// The context the policy saw (channels may show a rendering of it).
+    pub context: Context,
+    /// The best action, when the environment is simulated and knows it.
+    /// Only simulated experts may read this; a human channel must not show it.
+    pub oracle_best: Option<ArmId>,
+}
+
+/// An axis-aligned box in normalised image coordinates (0..1).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BoundingBox {
+    /// Left edge.
+    pub x0: f64,
+    /// Top edge.
+    pub y0: f64,
+    /// Right edge.
+    pub x1: f64,
+    /// Bottom edge.
+    pub y1: f64,
+}
+
+/// What the person answered.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Answer {
+    /// A robot action to use.
+    Action {
+        /// The chosen arm.
+        arm: ArmId,
+    },
+    /// A semantic label (e.g. the food's name).
+    Label {
+        /// The label.
+        label: String,
+    },
+    /// A bounding box around the item.
+    BoundingBox {
+        /// The box.
+        bbox: BoundingBox,
+    },
+    /// Free text.
+    Text {
+        /// The text.
+        text: String,
+    },
+    /// The person said they do not know.
+    Declined,
+    /// No answer arrived in time.
+    TimedOut,
+}
+
+/// A channel's response to a [`Query`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Response {
+    /// What the person answered.
+    pub answer: Answer,
+    /// The robot action the answer implies, if any. For [`Answer::Action`]
+    /// this is that arm; channels may map other answers to an action too.
+    pub expert_arm: Option<ArmId>,
+    /// Seconds the person took to answer, when measured or simulated.
+    pub response_time_s: Option<f64>,
+}
+
+impl Response {
+    /// A response choosing `arm`.
+    pub fn action(arm: ArmId) -> Self {
+        Self {
+            answer: Answer::Action { arm },
+            expert_arm: Some(arm),
+            response_time_s: None,
+        }
+    }
+
+    /// A response with no usable action.
+    pub fn without_action(answer: Answer) -> Self {
+        Self {
+            answer,
+            expert_arm: None,
+            response_time_s: None,
+        }
+    }
+}

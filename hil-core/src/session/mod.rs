@@ -1,0 +1,335 @@
+//! The session loop: one place where environment, policy, channel and
+//! workload model meet, with the paper's semantics.
+//!
+//! - An episode is a sequence of items; every attempt at an item is one
+//!   timestep and observes a fresh context of the item.
+//! - The policy decides to act or to query. After a query for the current
+//!   item, the expert's action is executed again on every later attempt at
+//!   that item (the policy is not consulted, but observes every outcome).
+//! - An item ends on success or after `n_att` attempts.
+//! - Workload is tracked from WL_0 and changes only at query steps.
+
+pub mod event;
+pub mod observer;
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use crate::action::ArmId;
+use crate::channel::QueryChannel;
+use crate::decision::Choice;
+use crate::environment::Environment;
+use crate::error::{HilError, Result};
+use crate::metrics::EpisodeMetrics;
+use crate::policy::{DecisionInput, Feedback, Policy};
+use crate::query::Query;
+use crate::workload::{DEFAULT_WL0, WorkloadForecast, WorkloadModel, WorkloadTracker, check_wl0};
+
+pub use event::{PendingStep, StepDecision, StepEvent};
+pub use observer::{EventCollector, SessionObserver};
+
+/// The paper's attempt limit per item in simulation.
+pub const DEFAULT_N_ATT: u32 = 10;
+
+/// Settings of the session loop.
+///
+/// ```
+/// let s = hil_core::SessionSettings::default();
+/// assert_eq!((s.n_att, s.wl0), (10, 0.5));
+/// s.validate().unwrap();
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SessionSettings {
+    /// Maximum attempts per item (N_att).
+    pub n_att: u32,
+    /// Initial workload WL_0 in [0, 1].
+    pub wl0: f64,
+    /// Stop after this many items even if the environment has more.
+    pub max_items: Option<usize>,
+}
+
+impl Default for SessionSettings {
+    fn default() -> Self {
+        Self {
+            n_att: DEFAULT_N_ATT,
+            wl0: DEFAULT_WL0,
+            max_items: None,
+        }
+    }
+}
+
+impl SessionSettings {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<()> {
+        if self.n_att == 0 {
+            return Err(HilError::invalid_parameter(
+                "n_att",
+                0,
+                "must be at least 1",
+            ));
+        }
+        check_wl0(self.wl0)
+    }
+}
+
+/// Independent seeds for each component, derived from one session seed so
+/// that adding randomness to one component never shifts another's stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ComponentSeeds {
+    /// Seed for the environment's `reset`.
+    pub environment: u64,
+    /// Seed for the policy.
+    pub policy: u64,
+    /// Seed for the query channel.
+    pub channel: u64,
+}
+
+impl ComponentSeeds {
+    /// Derives the component seeds from `seed` (SplitMix64 streams).
+    pub fn derive(seed: u64) -> Self {
+        Self {
+            environment: splitmix(seed, 1),
+            policy: splitmix(seed, 2),
+            channel: splitmix(seed, 3),
+        }
+    }
+}
+
+/// SplitMix64 of `seed` on stream `stream`: a cheap, well-mixed derivation.
+pub fn splitmix(seed: u64, stream: u64) -> u64 {
+    let mut z = seed
+        .wrapping_add(stream.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+        .wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Everything one episode produced.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct EpisodeReport {
+    /// The session seed.
+    pub seed: u64,
+    /// Every step, in order.
+    pub events: Vec<StepEvent>,
+    /// The metrics computed from the events.
+    pub metrics: EpisodeMetrics,
+}
+
+/// The components of a session, borrowed so that the caller keeps them
+/// (a policy carries its learning on to the next episode).
+pub struct Session<'a> {
+    /// Loop settings.
+    pub settings: SessionSettings,
+    /// Where the robot acts.
+    pub environment: &'a mut dyn Environment,
+    /// Who decides.
+    pub policy: &'a mut dyn Policy,
+    /// How queries reach the expert.
+    pub channel: &'a mut dyn QueryChannel,
+    /// The workload model that evolves the person's workload state and scores
+    /// the episode (in simulation, it stands in for the person).
+    pub workload: Arc<dyn WorkloadModel>,
+    /// The workload model the policy forecasts with; `None` means the same as
+    /// `workload`. They differ in the paper's cross-data experiment.
+    pub forecast: Option<Arc<dyn WorkloadModel>>,
+}
+
+impl std::fmt::Debug for Session<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Session")
+            .field("settings", &self.settings)
+            .field("environment", &self.environment.name())
+            .field("policy", &self.policy.name())
+            .field("channel", &self.channel.name())
+            .field("workload", &self.workload.name())
+            .field(
+                "forecast",
+                &self.forecast.as_ref().map(|m| m.name().to_string()),
+            )
+            .finish()
+    }
+}
+
+impl Session<'_> {
+    /// Runs one episode seeded by `seed`, reporting to `observers`.
+    pub fn run_episode(
+        &mut self,
+        seed: u64,
+        observers: &mut [&mut dyn SessionObserver],
+    ) -> Result<EpisodeReport> {
+        self.settings.validate()?;
+        self.check_shapes()?;
+        let seeds = ComponentSeeds::derive(seed);
+        self.environment.reset(seeds.environment)?;
+        self.policy.seed(seeds.policy);
+        self.channel.seed(seeds.channel);
+        for o in observers.iter_mut() {
+            o.on_episode_start(seed)?;
+        }
+
+        let mut tracker = WorkloadTracker::new(self.workload.clone(), self.settings.wl0)?;
+        let forecast_model = self
+            .forecast
+            .clone()
+            .unwrap_or_else(|| self.workload.clone());
+        let mut events = Vec::new();
+        let mut t = 0;
+        let mut items_seen = 0;
+        while self.settings.max_items.is_none_or(|m| items_seen < m) {
+            let Some(item) = self.environment.next_item()? else {
+                break;
+            };
+            for o in observers.iter_mut() {
+                o.on_item_start(&item)?;
+            }
+            let mut expert: Option<ArmId> = None;
+            for attempt in 0..self.settings.n_att {
+                t += 1;
+                let context = self.environment.observe()?;
+                context.check_dim(self.environment.context_dim())?;
+                let (decision, diagnostics, response, arm) = match expert {
+                    Some(arm) => (StepDecision::FollowExpert { arm }, None, None, arm),
+                    None => {
+                        let input = DecisionInput {
+                            context: &context,
+                            t,
+                            item_index: item.index,
+                            items_seen,
+                            attempt,
+                            workload: WorkloadForecast::new(
+                                Some(forecast_model.as_ref()),
+                                tracker.wl0(),
+                                tracker.history(),
+                                t,
+                            ),
+                        };
+                        let decision = self.policy.decide(&input)?;
+                        match decision.choice {
+                            Choice::Act { arm } => {
+                                self.check_arm(arm, "policy decision")?;
+                                (
+                                    StepDecision::Act { arm },
+                                    Some(decision.diagnostics),
+                                    None,
+                                    arm,
+                                )
+                            }
+                            Choice::Query { kind, fallback } => {
+                                self.check_arm(fallback, "policy fallback")?;
+                                let query = Query {
+                                    t,
+                                    item: item.clone(),
+                                    kind,
+                                    actions: self.environment.action_space().clone(),
+                                    context: context.clone(),
+                                    oracle_best: self.environment.best_action(),
+                                };
+                                let response = self.channel.ask(&query)?;
+                                // The person was interrupted whatever they answered.
+                                tracker.record(t, kind)?;
+                                let arm = match response.expert_arm {
+                                    Some(a) => {
+                                        self.check_arm(a, "expert answer")?;
+                                        expert = Some(a);
+                                        a
+                                    }
+                                    None => fallback,
+                                };
+                                (
+                                    StepDecision::Query { kind, fallback },
+                                    Some(decision.diagnostics),
+                                    Some(response),
+                                    arm,
+                                )
+                            }
+                        }
+                    }
+                };
+                let pending = PendingStep {
+                    t,
+                    item_index: item.index,
+                    item_label: item.label.clone(),
+                    attempt,
+                    context,
+                    decision,
+                    diagnostics,
+                    response,
+                    arm,
+                    wl: tracker.current(),
+                };
+                for o in observers.iter_mut() {
+                    o.before_execute(&pending)?;
+                }
+                let outcome = self.environment.execute(arm)?;
+                if let Some(p) = outcome.success_probability
+                    && !(0.0..=1.0).contains(&p)
+                {
+                    return Err(HilError::invalid_input(
+                        format!("success probability from `{}`", self.environment.name()),
+                        format!("{p} is outside [0, 1]"),
+                    ));
+                }
+                self.policy.observe(&Feedback {
+                    context: &pending.context,
+                    arm,
+                    reward: outcome.reward(),
+                    t,
+                    from_expert: expert.is_some(),
+                })?;
+                let event = StepEvent {
+                    step: pending,
+                    outcome,
+                };
+                for o in observers.iter_mut() {
+                    o.on_step(&event)?;
+                }
+                let success = event.outcome.success;
+                events.push(event);
+                if success {
+                    break;
+                }
+            }
+            items_seen += 1;
+        }
+        let metrics = EpisodeMetrics::from_events(&events, self.settings.wl0)?;
+        for o in observers.iter_mut() {
+            o.on_episode_end(&metrics)?;
+        }
+        Ok(EpisodeReport {
+            seed,
+            events,
+            metrics,
+        })
+    }
+
+    fn check_arm(&self, arm: ArmId, what: &str) -> Result<()> {
+        self.environment
+            .action_space()
+            .check(arm)
+            .map_err(|e| HilError::invalid_input(what.to_string(), e.to_string()))
+    }
+
+    fn check_shapes(&self) -> Result<()> {
+        let (env_arms, env_dim) = (
+            self.environment.action_space().len(),
+            self.environment.context_dim(),
+        );
+        if self.policy.n_arms() != env_arms || self.policy.dim() != env_dim {
+            return Err(HilError::invalid_input(
+                format!("policy `{}`", self.policy.name()),
+                format!(
+                    "it is built for {} arms and d = {}, but environment `{}` has {} arms and d = {}",
+                    self.policy.n_arms(),
+                    self.policy.dim(),
+                    self.environment.name(),
+                    env_arms,
+                    env_dim
+                ),
+            ));
+        }
+        Ok(())
+    }
+}

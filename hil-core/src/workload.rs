@@ -1,0 +1,296 @@
+//! Querying workload: the [`WorkloadModel`] trait, query histories, and the
+//! tracker the session loop uses.
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{HilError, Result};
+use crate::query::QueryKind;
+use crate::time::Timestep;
+
+/// The paper's initial workload for simulations (a median value).
+pub const DEFAULT_WL0: f64 = 0.5;
+
+/// One query in a history: when it was asked and what kind it was.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct QueryRecord {
+    /// Timestep at which the query was asked.
+    pub t: Timestep,
+    /// What was asked.
+    pub kind: QueryKind,
+}
+
+/// The history Q_t of queries asked so far, in time order.
+///
+/// ```
+/// use hil_core::{QueryHistory, QueryKind};
+/// let mut h = QueryHistory::new();
+/// h.push(3, QueryKind::default()).unwrap();
+/// assert!(h.push(2, QueryKind::default()).is_err()); // time runs forward
+/// assert_eq!(h.len(), 1);
+/// ```
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct QueryHistory {
+    records: Vec<QueryRecord>,
+}
+
+impl QueryHistory {
+    /// An empty history.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Builds a history, checking that times do not decrease.
+    pub fn from_records(records: Vec<QueryRecord>) -> Result<Self> {
+        let mut h = Self::new();
+        for r in records {
+            h.push(r.t, r.kind)?;
+        }
+        Ok(h)
+    }
+
+    /// Appends a query at `t`; `t` must not precede the last query.
+    /// Several queries at one timestep are allowed.
+    pub fn push(&mut self, t: Timestep, kind: QueryKind) -> Result<()> {
+        if let Some(last) = self.records.last()
+            && t < last.t
+        {
+            return Err(HilError::invalid_input(
+                "query time",
+                format!("t = {t} precedes the previous query at t = {}", last.t),
+            ));
+        }
+        self.records.push(QueryRecord { t, kind });
+        Ok(())
+    }
+
+    /// The records, oldest first.
+    pub fn records(&self) -> &[QueryRecord] {
+        &self.records
+    }
+
+    /// Number of queries.
+    pub fn len(&self) -> usize {
+        self.records.len()
+    }
+
+    /// True if no query was asked.
+    pub fn is_empty(&self) -> bool {
+        self.records.is_empty()
+    }
+
+    /// The time of the last query, if any.
+    pub fn last_time(&self) -> Option<Timestep> {
+        self.records.last().map(|r| r.t)
+    }
+
+    /// The queries asked in `(t - window, t]`, newest first, with their lag
+    /// `t - t_query`. Granger-style models read features from this.
+    pub fn recent(&self, t: Timestep, window: u64) -> impl Iterator<Item = (u64, &QueryRecord)> {
+        self.records
+            .iter()
+            .rev()
+            .filter(move |r| r.t <= t)
+            .map(move |r| (t - r.t, r))
+            .take_while(move |(lag, _)| *lag < window)
+    }
+}
+
+/// A model of querying workload: WL_t = f(WL_0, Q_t).
+///
+/// Contract (checked by `hil_core::testing::check_workload_model`):
+/// - predictions are finite for every WL_0 in [0, 1] and every history;
+/// - predictions are deterministic;
+/// - `predict_if_queried` equals `predict` on the history with the query appended.
+pub trait WorkloadModel: Send + Sync {
+    /// Short name for logs.
+    fn name(&self) -> &str;
+
+    /// Predicts WL_t from the initial workload and the queries asked up to `t`.
+    /// Queries in `history` later than `t` are ignored.
+    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64>;
+
+    /// The counterfactual WL_t if a query of `kind` were asked now, at `t`.
+    fn predict_if_queried(
+        &self,
+        wl0: f64,
+        history: &QueryHistory,
+        t: Timestep,
+        kind: QueryKind,
+    ) -> Result<f64> {
+        let mut h = history.clone();
+        h.push(t, kind)?;
+        self.predict(wl0, &h, t)
+    }
+}
+
+/// Checks that `wl0` is a workload score in [0, 1].
+pub fn check_wl0(wl0: f64) -> Result<()> {
+    if (0.0..=1.0).contains(&wl0) {
+        Ok(())
+    } else {
+        Err(HilError::invalid_parameter(
+            "wl0",
+            wl0,
+            "initial workload must be in [0, 1]",
+        ))
+    }
+}
+
+/// What a policy may ask about workload when it decides.
+#[derive(Clone, Copy)]
+pub struct WorkloadForecast<'a> {
+    model: Option<&'a dyn WorkloadModel>,
+    wl0: f64,
+    history: &'a QueryHistory,
+    t: Timestep,
+}
+
+impl std::fmt::Debug for WorkloadForecast<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WorkloadForecast")
+            .field("model", &self.model.map(|m| m.name().to_string()))
+            .field("wl0", &self.wl0)
+            .field("queries", &self.history.len())
+            .field("t", &self.t)
+            .finish()
+    }
+}
+
+impl<'a> WorkloadForecast<'a> {
+    /// A forecast backed by `model` (or none).
+    pub fn new(
+        model: Option<&'a dyn WorkloadModel>,
+        wl0: f64,
+        history: &'a QueryHistory,
+        t: Timestep,
+    ) -> Self {
+        Self {
+            model,
+            wl0,
+            history,
+            t,
+        }
+    }
+
+    /// A forecast with no model: asking it for a prediction is an error.
+    pub fn none(history: &'a QueryHistory) -> Self {
+        Self::new(None, DEFAULT_WL0, history, 0)
+    }
+
+    /// The initial workload.
+    pub fn wl0(&self) -> f64 {
+        self.wl0
+    }
+
+    /// The queries asked so far.
+    pub fn history(&self) -> &QueryHistory {
+        self.history
+    }
+
+    /// The predicted WL_t if a query of `kind` were asked now.
+    pub fn if_queried(&self, kind: QueryKind) -> Result<f64> {
+        self.model()?
+            .predict_if_queried(self.wl0, self.history, self.t, kind)
+    }
+
+    /// The predicted WL_t without a query now.
+    pub fn now(&self) -> Result<f64> {
+        self.model()?.predict(self.wl0, self.history, self.t)
+    }
+
+    fn model(&self) -> Result<&'a dyn WorkloadModel> {
+        self.model.ok_or_else(|| {
+            HilError::state(
+                "workload forecast",
+                "no workload model is configured for this policy",
+            )
+        })
+    }
+}
+
+/// Tracks the workload state of one person through a session. The state
+/// starts at WL_0 and changes only when a query is asked.
+///
+/// ```
+/// use std::sync::Arc;
+/// use hil_core::{WorkloadTracker, QueryKind, WorkloadModel, QueryHistory, Timestep};
+/// # struct PerQuery;
+/// # impl WorkloadModel for PerQuery {
+/// #     fn name(&self) -> &str { "per_query" }
+/// #     fn predict(&self, wl0: f64, h: &QueryHistory, _t: Timestep) -> hil_core::Result<f64> {
+/// #         Ok((wl0 + 0.1 * h.len() as f64).min(1.0))
+/// #     }
+/// # }
+/// let mut tr = WorkloadTracker::new(Arc::new(PerQuery), 0.5).unwrap();
+/// assert_eq!(tr.current(), 0.5);
+/// tr.record(4, QueryKind::default()).unwrap();
+/// assert!((tr.current() - 0.6).abs() < 1e-12);
+/// ```
+#[derive(Clone)]
+pub struct WorkloadTracker {
+    model: Arc<dyn WorkloadModel>,
+    wl0: f64,
+    history: QueryHistory,
+    current: f64,
+}
+
+impl std::fmt::Debug for WorkloadTracker {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WorkloadTracker")
+            .field("model", &self.model.name())
+            .field("wl0", &self.wl0)
+            .field("history", &self.history)
+            .field("current", &self.current)
+            .finish()
+    }
+}
+
+impl WorkloadTracker {
+    /// Starts tracking from `wl0` (must be in [0, 1]).
+    pub fn new(model: Arc<dyn WorkloadModel>, wl0: f64) -> Result<Self> {
+        check_wl0(wl0)?;
+        Ok(Self {
+            model,
+            wl0,
+            history: QueryHistory::new(),
+            current: wl0,
+        })
+    }
+
+    /// Records a query at `t` and updates the workload state.
+    pub fn record(&mut self, t: Timestep, kind: QueryKind) -> Result<f64> {
+        self.history.push(t, kind)?;
+        let wl = self.model.predict(self.wl0, &self.history, t)?;
+        if !wl.is_finite() {
+            return Err(HilError::invalid_input(
+                format!("workload prediction of `{}`", self.model.name()),
+                format!("{wl} is not finite"),
+            ));
+        }
+        self.current = wl;
+        Ok(wl)
+    }
+
+    /// The current workload state WL_t.
+    pub fn current(&self) -> f64 {
+        self.current
+    }
+
+    /// The initial workload WL_0.
+    pub fn wl0(&self) -> f64 {
+        self.wl0
+    }
+
+    /// The queries recorded so far.
+    pub fn history(&self) -> &QueryHistory {
+        &self.history
+    }
+
+    /// The model behind the tracker.
+    pub fn model(&self) -> &dyn WorkloadModel {
+        self.model.as_ref()
+    }
+}

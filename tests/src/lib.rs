@@ -1,0 +1,1 @@
+//! Workspace-level integration and property suites live in `tests/tests/`.

@@ -33,6 +33,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::action::ActionSpace;
 use crate::channel::QueryChannel;
+use crate::decision::LabelledObservation;
 use crate::environment::Environment;
 use crate::error::Result;
 use crate::policy::Policy;
@@ -50,6 +51,9 @@ pub struct BuildContext {
     pub action_space: Option<ActionSpace>,
     /// The environment's context dimension (known once it is built).
     pub context_dim: Option<usize>,
+    /// Offline (context, arm, reward) data the environment offers for
+    /// pretraining (see [`EnvironmentConfig::pretraining`]).
+    pub pretraining: Option<Arc<[LabelledObservation]>>,
 }
 
 impl BuildContext {
@@ -60,6 +64,7 @@ impl BuildContext {
             seed,
             action_space: None,
             context_dim: None,
+            pretraining: None,
         }
     }
 
@@ -86,6 +91,14 @@ pub trait PolicyConfig: std::fmt::Debug + Send + Sync {
 pub trait EnvironmentConfig: std::fmt::Debug + Send + Sync {
     /// Validates the parameters and builds the environment.
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Environment>>;
+
+    /// Offline data for pretraining policies (e.g. the pretraining foods of
+    /// a dataset), handed to policy configs through
+    /// [`BuildContext::pretraining`]. None by default.
+    fn pretraining(&self, ctx: &BuildContext) -> Result<Option<Arc<[LabelledObservation]>>> {
+        let _ = ctx;
+        Ok(None)
+    }
 }
 
 /// A serialisable recipe for a [`WorkloadModel`].

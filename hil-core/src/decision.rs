@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::action::ArmId;
+use crate::context::Context;
 use crate::query::QueryKind;
 
 /// The choice a policy makes: act with a robot arm, or ask the human.
@@ -109,4 +110,16 @@ impl Outcome {
     pub fn task_reward(&self) -> f64 {
         self.success_probability.unwrap_or_else(|| self.reward())
     }
+}
+
+/// An offline observation: a context, the arm tried, and the reward seen.
+/// Pretraining data for estimator-based policies.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LabelledObservation {
+    /// The context.
+    pub context: Context,
+    /// The arm that was tried.
+    pub arm: ArmId,
+    /// The reward observed (1 success, 0 failure, or a success probability).
+    pub reward: f64,
 }

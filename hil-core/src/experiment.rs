@@ -84,6 +84,7 @@ impl ExperimentConfig {
         let environment = self.environment.build(&ctx)?;
         ctx.action_space = Some(environment.action_space().clone());
         ctx.context_dim = Some(environment.context_dim());
+        ctx.pretraining = self.environment.pretraining(&ctx)?;
         let policy = self.policy.build(&ctx)?;
         let workload = self.workload.build(&ctx)?;
         let forecast = match &self.policy_workload {

@@ -40,7 +40,7 @@ pub use action::{ActionSpace, ArmId, FEEDING_ACTIONS};
 pub use channel::QueryChannel;
 pub use config::{BuildContext, ConfigError, ExperimentConfig};
 pub use context::Context;
-pub use decision::{ArmDiagnostics, Choice, Decision, Diagnostics, Outcome};
+pub use decision::{ArmDiagnostics, Choice, Decision, Diagnostics, LabelledObservation, Outcome};
 pub use environment::{Environment, Item};
 pub use error::{HilError, Result};
 pub use experiment::{Experiment, ExperimentSummary};

@@ -1,10 +1,49 @@
 //! # hil-envs
 //!
-//! The dataset-replay environment and the paper's simulated testbed.
+//! The paper's simulated testbed for human-in-the-loop bite acquisition:
 //!
-//! Status: not implemented yet (tracked by the environments issue). This
-//! crate currently exports nothing.
+//! - [`dataset`]: the food dataset format (a TOML manifest plus NumPy `.npy`
+//!   arrays), its validating loader and writer; [`npy`]: the `.npy` codec;
+//! - [`rates`]: the published per-food success rates the bundled data is
+//!   calibrated to; [`generate`]: the seeded synthetic dataset generator;
+//! - [`DatasetReplayEnv`]: the dataset-replay [`hil_core::Environment`]
+//!   (config type `food_replay`);
+//! - [`split`]: food-level pretrain / validation / test splits;
+//! - [`protocol`]: the paper's experiment protocol (runs, hyperparameter
+//!   selection on validation, evaluation on test, the cross-data experiment);
+//! - [`report`] and [`plot`]: results JSON, Markdown tables beside the
+//!   paper's published numbers ([`published`]), SVG figures.
+//!
+//! **The bundled dataset is synthetic**, calibrated to published figures; it
+//! is not the paper's data, and results computed from it are not the paper's
+//! results.
+
+pub mod dataset;
+pub mod env;
+pub mod generate;
+pub mod npy;
+pub mod rates;
+pub mod split;
+
+use std::sync::{Arc, OnceLock};
+
+pub use dataset::{Food, FoodDataset, FoodImage};
+pub use env::{DatasetReplayEnv, FoodReplayConfig, OutcomeMode, PretrainReward};
+pub use split::FoodSplit;
 
 /// Does nothing; calling it keeps this crate (and its typetag registrations)
 /// linked into a binary that names its components only in configs.
 pub fn link() {}
+
+static BUNDLED: OnceLock<Arc<FoodDataset>> = OnceLock::new();
+
+/// The bundled synthetic dataset (16 foods × 30 images, d = 2048), generated
+/// in memory on first use by [`generate::SyntheticFoods::default`] and shared
+/// afterwards. Deterministic: every process gets the same data.
+pub fn bundled_dataset() -> hil_core::Result<Arc<FoodDataset>> {
+    if let Some(d) = BUNDLED.get() {
+        return Ok(d.clone());
+    }
+    let d = Arc::new(generate::SyntheticFoods::default().generate()?.dataset);
+    Ok(BUNDLED.get_or_init(|| d).clone())
+}

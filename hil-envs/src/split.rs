@@ -1,0 +1,111 @@
+//! Splitting a dataset's foods into pretraining, validation and test sets.
+
+use hil_core::{HilError, Result};
+use serde::{Deserialize, Serialize};
+
+use crate::dataset::FoodDataset;
+
+/// The foods of each phase of the protocol. Splitting is by food type: no
+/// food appears in two sets.
+///
+/// ```
+/// use hil_envs::split::FoodSplit;
+/// let ds = hil_envs::bundled_dataset().unwrap();
+/// let split = FoodSplit::paper();
+/// split.validate(&ds).unwrap();
+/// assert_eq!(split.pretrain.len(), 12);
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FoodSplit {
+    /// Foods the estimator is pretrained on.
+    pub pretrain: Vec<String>,
+    /// Foods hyperparameters are chosen on.
+    pub validation: Vec<String>,
+    /// Foods the chosen hyperparameters are evaluated on.
+    pub test: Vec<String>,
+}
+
+/// The paper's validation foods.
+pub const PAPER_VALIDATION: [&str; 2] = ["cantaloupe", "grape"];
+/// The paper's test foods.
+pub const PAPER_TEST: [&str; 2] = ["banana", "carrot"];
+/// The paper's twelve pretraining foods.
+pub const PAPER_PRETRAIN: [&str; 12] = [
+    "apple",
+    "bell_pepper",
+    "broccoli",
+    "cauliflower",
+    "celery",
+    "cherry_tomato",
+    "honeydew",
+    "kiwi",
+    "strawberry",
+    "lettuce",
+    "spinach",
+    "kale",
+];
+
+impl FoodSplit {
+    /// The paper's split: validation cantaloupe, grape; test banana, carrot;
+    /// the other twelve foods pretrain.
+    pub fn paper() -> Self {
+        let v = |s: &[&str]| s.iter().map(|x| x.to_string()).collect();
+        Self {
+            pretrain: v(&PAPER_PRETRAIN),
+            validation: v(&PAPER_VALIDATION),
+            test: v(&PAPER_TEST),
+        }
+    }
+
+    /// The sets with their names, in protocol order.
+    pub fn sets(&self) -> [(&'static str, &[String]); 3] {
+        [
+            ("pretrain", &self.pretrain),
+            ("validation", &self.validation),
+            ("test", &self.test),
+        ]
+    }
+
+    /// Checks that every set is non-empty, every food exists in `ds`, and no
+    /// food is listed twice (within or across sets).
+    pub fn validate(&self, ds: &FoodDataset) -> Result<()> {
+        check_disjoint(&self.sets(), ds)
+    }
+}
+
+/// Checks named food lists against `ds`: non-empty, known, disjoint.
+pub fn check_disjoint(sets: &[(&str, &[String])], ds: &FoodDataset) -> Result<()> {
+    let mut seen: Vec<(&str, &str)> = Vec::new();
+    for (set, foods) in sets {
+        if foods.is_empty() {
+            return Err(HilError::invalid_parameter(
+                format!("split.{set}"),
+                "[]",
+                "the set is empty",
+            ));
+        }
+        for f in foods.iter() {
+            if ds.food_index(f).is_none() {
+                return Err(HilError::invalid_parameter(
+                    format!("split.{set}"),
+                    f,
+                    format!(
+                        "unknown food; dataset `{}` has: {}",
+                        ds.name,
+                        ds.food_names().join(", ")
+                    ),
+                ));
+            }
+            if let Some((other, _)) = seen.iter().find(|(_, g)| g == f) {
+                return Err(HilError::invalid_parameter(
+                    format!("split.{set}"),
+                    f,
+                    format!("the food is also in split.{other}; a food may be in one set only"),
+                ));
+            }
+            seen.push((set, f));
+        }
+    }
+    Ok(())
+}

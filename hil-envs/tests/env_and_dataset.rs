@@ -1,0 +1,264 @@
+//! DatasetReplayEnv conformance, dataset round trips and loader errors.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use hil_core::testing::check_environment;
+use hil_core::{ArmId, Environment};
+use hil_envs::dataset::FoodDataset;
+use hil_envs::generate::SyntheticFoods;
+use hil_envs::npy::{NpyArray, read_npy, write_npy};
+use hil_envs::{DatasetReplayEnv, FoodSplit, OutcomeMode};
+
+fn small() -> Arc<FoodDataset> {
+    Arc::new(
+        SyntheticFoods {
+            dim: 130,
+            images_per_setting: 3,
+            ..SyntheticFoods::default()
+        }
+        .generate()
+        .unwrap()
+        .dataset,
+    )
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hil-envs-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+#[test]
+fn replay_env_passes_the_conformance_suite() {
+    let ds = small();
+    let foods = vec!["banana".to_string(), "carrot".to_string()];
+    check_environment(
+        &|| Ok(Box::new(DatasetReplayEnv::new(ds.clone(), &foods, 5)?)),
+        10,
+    )
+    .unwrap();
+}
+
+#[test]
+fn bundled_replay_env_passes_the_conformance_suite() {
+    let ds = hil_envs::bundled_dataset().unwrap();
+    assert_eq!(ds.context_dim, 2048);
+    let foods = vec!["cantaloupe".to_string(), "grape".to_string()];
+    check_environment(
+        &|| Ok(Box::new(DatasetReplayEnv::new(ds.clone(), &foods, 3)?)),
+        4,
+    )
+    .unwrap();
+}
+
+#[test]
+fn best_action_is_argmax_and_success_frequency_matches_probability() {
+    let ds = small();
+    let mut env = DatasetReplayEnv::new(ds.clone(), &["apple".into()], 400).unwrap();
+    env.reset(5).unwrap();
+    let (mut succ, mut prob) = (0.0, 0.0);
+    let mut n = 0.0;
+    while env.next_item().unwrap().is_some() {
+        let x = env.observe().unwrap();
+        let img = &ds.foods[0].images[env.last_image().unwrap()];
+        assert_eq!(img.context, x);
+        let best = env.best_action().unwrap();
+        assert!(img.success.iter().all(|p| *p <= img.success[best.0]));
+        let out = env.execute(ArmId(0)).unwrap();
+        prob += out.success_probability.unwrap();
+        succ += out.reward();
+        n += 1.0;
+    }
+    // 400 Bernoulli draws: the frequency is within 4 standard errors.
+    assert!(
+        (succ / n - prob / n).abs() < 4.0 * 0.5 / 20.0,
+        "{succ} {prob}"
+    );
+}
+
+#[test]
+fn replay_mode_replays_recorded_outcomes() {
+    let mut ds = (*small()).clone();
+    for f in &mut ds.foods {
+        for img in &mut f.images {
+            // Record "always fails" except action 1, "always succeeds".
+            img.outcomes = Some((0..6).map(|a| vec![a == 1; 3]).collect());
+        }
+    }
+    let ds = Arc::new(ds);
+    let mut env = DatasetReplayEnv::new(ds.clone(), &["carrot".into()], 3)
+        .unwrap()
+        .with_outcomes(OutcomeMode::Replay)
+        .unwrap();
+    env.reset(0).unwrap();
+    env.next_item().unwrap();
+    env.observe().unwrap();
+    assert!(env.execute(ArmId(1)).unwrap().success);
+    env.observe().unwrap();
+    assert!(!env.execute(ArmId(3)).unwrap().success);
+    // Without recordings, replay is refused up front.
+    assert!(
+        DatasetReplayEnv::new(small(), &["carrot".into()], 3)
+            .unwrap()
+            .with_outcomes(OutcomeMode::Replay)
+            .is_err()
+    );
+}
+
+#[test]
+fn out_of_order_calls_are_errors() {
+    let mut env = DatasetReplayEnv::new(small(), &["kiwi".into()], 1).unwrap();
+    assert!(env.observe().is_err());
+    env.reset(0).unwrap();
+    env.next_item().unwrap();
+    assert!(env.execute(ArmId(0)).is_err()); // before observe
+    env.observe().unwrap();
+    assert!(env.execute(ArmId(6)).is_err());
+}
+
+#[test]
+fn save_then_load_round_trips_with_outcomes() {
+    let mut ds = (*small()).clone();
+    ds.foods.truncate(3);
+    ds.foods[1].images[0].context = hil_core::Context::new(vec![0.5; 130]).unwrap();
+    for img in &mut ds.foods[2].images {
+        img.outcomes = Some((0..6).map(|a| vec![a % 2 == 0, true]).collect());
+    }
+    let dir = tmp("roundtrip");
+    let manifest = ds.save(&dir).unwrap();
+    let back = FoodDataset::load(&manifest).unwrap();
+    assert_eq!(back, ds);
+    assert_eq!(FoodDataset::load(&dir).unwrap(), ds);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Saves a small dataset, then lets `corrupt` damage it, and returns the load error.
+fn load_error(name: &str, corrupt: impl FnOnce(&Path)) -> String {
+    let mut ds = (*small()).clone();
+    ds.foods.truncate(2);
+    let dir = tmp(name);
+    ds.save(&dir).unwrap();
+    corrupt(&dir);
+    let e = FoodDataset::load(&dir).unwrap_err().to_string();
+    std::fs::remove_dir_all(&dir).unwrap();
+    e
+}
+
+fn edit_array(path: &Path, f: impl FnOnce(&mut NpyArray)) {
+    let mut a = read_npy(path).unwrap();
+    f(&mut a);
+    write_npy(path, &a).unwrap();
+}
+
+#[test]
+fn loader_errors_name_file_record_and_field() {
+    let e = load_error("nan", |d| {
+        edit_array(&d.join("apple/contexts.npy"), |a| {
+            a.data[130 * 4 + 7] = f64::NAN
+        })
+    });
+    assert!(
+        e.contains("apple/contexts.npy:5") && e.contains("not finite"),
+        "{e}"
+    );
+
+    let e = load_error("prob", |d| {
+        edit_array(&d.join("banana/success.npy"), |a| a.data[6 * 2 + 3] = 1.5)
+    });
+    assert!(
+        e.contains("banana/success.npy:3") && e.contains("outside [0, 1]"),
+        "{e}"
+    );
+
+    let e = load_error("dim", |d| {
+        let m = std::fs::read_to_string(d.join("dataset.toml")).unwrap();
+        std::fs::write(
+            d.join("dataset.toml"),
+            m.replace("context_dim = 130", "context_dim = 128"),
+        )
+        .unwrap();
+    });
+    assert!(
+        e.contains("apple/contexts.npy") && e.contains("shape"),
+        "{e}"
+    );
+
+    let e = load_error("setting", |d| {
+        edit_array(&d.join("apple/settings.npy"), |a| a.data[2] = 7.0)
+    });
+    assert!(
+        e.contains("apple/settings.npy:3") && e.contains("setting index"),
+        "{e}"
+    );
+
+    let e = load_error("unknown-field", |d| {
+        let m = std::fs::read_to_string(d.join("dataset.toml")).unwrap();
+        std::fs::write(d.join("dataset.toml"), format!("colour = 1\n{m}")).unwrap();
+    });
+    assert!(e.contains("dataset.toml:1") && e.contains("colour"), "{e}");
+
+    let e = load_error("rows", |d| {
+        edit_array(&d.join("banana/success.npy"), |a| {
+            a.shape[0] -= 1;
+            a.data.truncate(a.data.len() - 6);
+        })
+    });
+    assert!(
+        e.contains("banana/success.npy") && e.contains("shape"),
+        "{e}"
+    );
+}
+
+#[test]
+fn splits_reject_unknown_empty_and_shared_foods() {
+    let ds = small();
+    FoodSplit::paper().validate(&ds).unwrap();
+    let mut s = FoodSplit::paper();
+    s.test.push("durian".into());
+    let e = s.validate(&ds).unwrap_err().to_string();
+    assert!(
+        e.contains("split.test") && e.contains("durian") && e.contains("unknown"),
+        "{e}"
+    );
+    let mut s = FoodSplit::paper();
+    s.validation.clear();
+    assert!(
+        s.validate(&ds)
+            .unwrap_err()
+            .to_string()
+            .contains("split.validation")
+    );
+    let mut s = FoodSplit::paper();
+    s.test.push("apple".into());
+    let e = s.validate(&ds).unwrap_err().to_string();
+    assert!(e.contains("apple") && e.contains("split.pretrain"), "{e}");
+}
+
+#[test]
+fn food_replay_config_builds_and_offers_pretraining_data() {
+    let text = r#"
+type = "food_replay"
+foods = ["banana", "carrot"]
+pretrain_foods = ["apple", "kiwi"]
+items_per_episode = 4
+"#;
+    let cfg: Box<dyn hil_core::config::EnvironmentConfig> = toml::from_str(text).unwrap();
+    let ctx = hil_core::BuildContext::new(".", 0);
+    let env = cfg.build(&ctx).unwrap();
+    assert_eq!(env.context_dim(), 2048);
+    let pre = cfg.pretraining(&ctx).unwrap().unwrap();
+    assert_eq!(pre.len(), 2 * 30 * 6);
+    let bad: Box<dyn hil_core::config::EnvironmentConfig> = toml::from_str(
+        "type = \"food_replay\"\nfoods = [\"banana\"]\npretrain_foods = [\"banana\"]\n",
+    )
+    .unwrap();
+    let e = bad.build(&ctx).err().unwrap().to_string();
+    assert!(e.contains("banana") && e.contains("pretrain_foods"), "{e}");
+    assert!(
+        toml::from_str::<Box<dyn hil_core::config::EnvironmentConfig>>(
+            "type = \"food_replay\"\nfoods = [\"banana\"]\nfood = 1\n"
+        )
+        .is_err()
+    );
+}

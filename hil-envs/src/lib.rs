@@ -22,7 +22,10 @@ pub mod dataset;
 pub mod env;
 pub mod generate;
 pub mod npy;
+pub mod protocol;
+pub mod published;
 pub mod rates;
+pub mod results;
 pub mod split;
 
 use std::sync::{Arc, OnceLock};

@@ -22,9 +22,11 @@ pub mod dataset;
 pub mod env;
 pub mod generate;
 pub mod npy;
+pub mod plot;
 pub mod protocol;
 pub mod published;
 pub mod rates;
+pub mod report;
 pub mod results;
 pub mod split;
 

@@ -166,8 +166,11 @@ fn score_all(
         .collect()
 }
 
+/// A policy spec with the index of the model it decides with (QG only).
+type Candidate = (PolicySpec, Option<usize>);
+
 /// Candidates of `family` when the decision model is `m`.
-fn candidates(s: &ProtocolSettings, family: Family, m: usize) -> Vec<(PolicySpec, Option<usize>)> {
+fn candidates(s: &ProtocolSettings, family: Family, m: usize) -> Vec<Candidate> {
     match family {
         Family::Linucb => vec![(PolicySpec::Linucb, None)],
         Family::AlwaysQuery => vec![(PolicySpec::AlwaysQuery, None)],
@@ -192,8 +195,8 @@ fn select(
     m: usize,
     family: Family,
     w_task: f64,
-) -> Result<((PolicySpec, Option<usize>), Vec<(f64, f64)>)> {
-    let mut best: Option<((PolicySpec, Option<usize>), f64)> = None;
+) -> Result<(Candidate, Vec<(f64, f64)>)> {
+    let mut best: Option<(Candidate, f64)> = None;
     let mut table = Vec::new();
     for cand in candidates(s, family, m) {
         let runs = idx.runs(Phase::Validation, &cand.0, cand.1);

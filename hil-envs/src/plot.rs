@@ -1,0 +1,290 @@
+//! Dependency-free SVG figures of protocol runs: the LinUCB-QG rollout (WL_t,
+//! the gap G, the threshold w·WL_t and the query times) and the workload of
+//! several policies over one episode.
+
+use std::fmt::Write as _;
+
+use hil_core::{Result, WorkloadModel};
+
+use crate::protocol::RunRecord;
+
+const W: f64 = 760.0;
+const PANEL_H: f64 = 210.0;
+const LEFT: f64 = 60.0;
+const RIGHT: f64 = 20.0;
+const TOP: f64 = 34.0;
+const GAP: f64 = 46.0;
+
+/// One panel's coordinate system.
+struct Panel {
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    top: f64,
+}
+
+impl Panel {
+    fn px(&self, x: f64) -> f64 {
+        LEFT + (x - self.x0) / (self.x1 - self.x0).max(1e-9) * (W - LEFT - RIGHT)
+    }
+    fn py(&self, y: f64) -> f64 {
+        self.top + PANEL_H - (y - self.y0) / (self.y1 - self.y0).max(1e-9) * PANEL_H
+    }
+
+    fn frame(&self, out: &mut String, title: &str, ylabel: &str) {
+        let (l, r) = (LEFT, W - RIGHT);
+        let (t, b) = (self.top, self.top + PANEL_H);
+        let _ = writeln!(
+            out,
+            r##"<rect x="{l}" y="{t}" width="{}" height="{PANEL_H}" fill="none" stroke="#444"/>"##,
+            r - l
+        );
+        let _ = writeln!(
+            out,
+            r##"<text x="{l}" y="{}" font-size="13" font-weight="bold">{}</text>"##,
+            t - 8.0,
+            esc(title)
+        );
+        let _ = writeln!(
+            out,
+            r##"<text x="14" y="{}" font-size="11" transform="rotate(-90 14 {})" text-anchor="middle">{}</text>"##,
+            t + PANEL_H / 2.0,
+            t + PANEL_H / 2.0,
+            esc(ylabel)
+        );
+        for k in 0..=4 {
+            let y = self.y0 + (self.y1 - self.y0) * k as f64 / 4.0;
+            let py = self.py(y);
+            let _ = writeln!(
+                out,
+                r##"<line x1="{}" y1="{py:.1}" x2="{l}" y2="{py:.1}" stroke="#444"/><text x="{}" y="{:.1}" font-size="10" text-anchor="end">{y:.2}</text>"##,
+                l - 4.0,
+                l - 6.0,
+                py + 3.0
+            );
+        }
+        let span = (self.x1 - self.x0).max(1.0);
+        let step = (span / 10.0).ceil().max(1.0);
+        let mut x = self.x0;
+        while x <= self.x1 + 1e-9 {
+            let px = self.px(x);
+            let _ = writeln!(
+                out,
+                r##"<line x1="{px:.1}" y1="{b}" x2="{px:.1}" y2="{}" stroke="#444"/><text x="{px:.1}" y="{}" font-size="10" text-anchor="middle">{x}</text>"##,
+                b + 4.0,
+                b + 15.0
+            );
+            x += step;
+        }
+        let _ = writeln!(
+            out,
+            r##"<text x="{}" y="{}" font-size="11" text-anchor="middle">timestep t (Δt = 10 s)</text>"##,
+            (l + r) / 2.0,
+            b + 30.0
+        );
+    }
+
+    fn polyline(&self, out: &mut String, pts: &[(f64, f64)], colour: &str, dash: bool) {
+        if pts.is_empty() {
+            return;
+        }
+        let d: Vec<String> = pts
+            .iter()
+            .map(|(x, y)| format!("{:.1},{:.1}", self.px(*x), self.py(*y)))
+            .collect();
+        let _ = writeln!(
+            out,
+            r##"<polyline points="{}" fill="none" stroke="{colour}" stroke-width="1.8"{}/>"##,
+            d.join(" "),
+            if dash {
+                r#" stroke-dasharray="5,3""#
+            } else {
+                ""
+            }
+        );
+    }
+
+    fn item_starts(&self, out: &mut String, run: &RunRecord) {
+        let mut last = None;
+        for s in &run.steps {
+            if last != Some(s.item_index) {
+                last = Some(s.item_index);
+                let px = self.px(s.t as f64 - 0.5);
+                let _ = writeln!(
+                    out,
+                    r##"<line x1="{px:.1}" y1="{}" x2="{px:.1}" y2="{}" stroke="#999" stroke-dasharray="2,3"/><text x="{:.1}" y="{}" font-size="9" fill="#666">{}</text>"##,
+                    self.top,
+                    self.top + PANEL_H,
+                    px + 2.0,
+                    self.top + 10.0,
+                    esc(&s.food)
+                );
+            }
+        }
+    }
+
+    fn queries(&self, out: &mut String, run: &RunRecord, wl: &[f64]) {
+        for q in run.queries.records() {
+            let y = wl.get(q.t as usize).copied().unwrap_or(0.0);
+            let _ = writeln!(
+                out,
+                r##"<circle cx="{:.1}" cy="{:.1}" r="5" fill="none" stroke="red" stroke-width="2"/>"##,
+                self.px(q.t as f64),
+                self.py(y)
+            );
+        }
+    }
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+fn header(h: f64) -> String {
+    format!(
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{h}" viewBox="0 0 {W} {h}" font-family="sans-serif">
+<rect width="100%" height="100%" fill="white"/>
+"##
+    )
+}
+
+fn legend(out: &mut String, y: f64, entries: &[(&str, &str)]) {
+    let mut x = LEFT;
+    for (colour, label) in entries {
+        let _ = writeln!(
+            out,
+            r##"<line x1="{x}" y1="{y}" x2="{}" y2="{y}" stroke="{colour}" stroke-width="2"/><text x="{}" y="{}" font-size="11">{}</text>"##,
+            x + 18.0,
+            x + 22.0,
+            y + 4.0,
+            esc(label)
+        );
+        x += 30.0 + 7.0 * label.len() as f64;
+    }
+}
+
+/// The LinUCB-QG rollout figure: WL_t under `model` (line), the gap G and
+/// the threshold w·WL_t at the steps where the policy decided, red circles
+/// at queries, dotted lines at item starts. `note` is printed under the
+/// title (say the data is synthetic).
+pub fn rollout_svg(
+    run: &RunRecord,
+    model: &dyn WorkloadModel,
+    wl0: f64,
+    title: &str,
+    note: &str,
+) -> Result<String> {
+    let wl = run.workload_curve(model, wl0)?;
+    let gaps: Vec<(f64, f64)> = run
+        .steps
+        .iter()
+        .filter_map(|s| s.gap.map(|g| (s.t as f64, g)))
+        .collect();
+    let thr: Vec<(f64, f64)> = run
+        .steps
+        .iter()
+        .filter_map(|s| s.threshold.map(|g| (s.t as f64, g)))
+        .collect();
+    let ys = wl
+        .iter()
+        .copied()
+        .chain(gaps.iter().map(|p| p.1))
+        .chain(thr.iter().map(|p| p.1));
+    let (lo, hi) = ys.fold((0.0f64, 1.0f64), |(a, b), y| (a.min(y), b.max(y)));
+    let p = Panel {
+        x0: 0.0,
+        x1: run.t_final.max(1) as f64,
+        y0: lo,
+        y1: hi,
+        top: TOP + 14.0,
+    };
+    let mut out = header(TOP + 14.0 + PANEL_H + 70.0);
+    let _ = writeln!(
+        out,
+        r##"<text x="{LEFT}" y="16" font-size="11" fill="#a00">{}</text>"##,
+        esc(note)
+    );
+    p.frame(&mut out, title, "value");
+    p.item_starts(&mut out, run);
+    let wl_pts: Vec<(f64, f64)> = wl.iter().enumerate().map(|(t, y)| (t as f64, *y)).collect();
+    p.polyline(&mut out, &wl_pts, "#1f5fbf", false);
+    p.polyline(&mut out, &gaps, "#e08a00", false);
+    p.polyline(&mut out, &thr, "#555", true);
+    for (x, y) in &gaps {
+        let _ = writeln!(
+            out,
+            r##"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="#e08a00"/>"##,
+            p.px(*x),
+            p.py(*y)
+        );
+    }
+    p.queries(&mut out, run, &wl);
+    legend(
+        &mut out,
+        TOP + 14.0 + PANEL_H + 48.0,
+        &[
+            ("#1f5fbf", "WL_t"),
+            ("#e08a00", "gap G"),
+            ("#555", "threshold w·WL_t (dashed)"),
+            ("red", "query (circle)"),
+        ],
+    );
+    out.push_str("</svg>\n");
+    Ok(out)
+}
+
+/// Stacked panels of WL_t under `model` for several runs (one per policy)
+/// of the same episode, with query times and item starts.
+pub fn workload_comparison_svg(
+    runs: &[(&str, &RunRecord)],
+    model: &dyn WorkloadModel,
+    wl0: f64,
+    note: &str,
+) -> Result<String> {
+    let x1 = runs
+        .iter()
+        .map(|(_, r)| r.t_final)
+        .max()
+        .unwrap_or(1)
+        .max(1) as f64;
+    let mut curves = Vec::new();
+    for (_, r) in runs {
+        curves.push(r.workload_curve(model, wl0)?);
+    }
+    let (lo, hi) = curves
+        .iter()
+        .flatten()
+        .fold((0.0f64, 1.0f64), |(a, b), y| (a.min(*y), b.max(*y)));
+    let h = TOP + 14.0 + runs.len() as f64 * (PANEL_H + GAP) + 20.0;
+    let mut out = header(h);
+    let _ = writeln!(
+        out,
+        r##"<text x="{LEFT}" y="16" font-size="11" fill="#a00">{}</text>"##,
+        esc(note)
+    );
+    for (k, ((label, run), wl)) in runs.iter().zip(&curves).enumerate() {
+        let p = Panel {
+            x0: 0.0,
+            x1,
+            y0: lo,
+            y1: hi,
+            top: TOP + 14.0 + k as f64 * (PANEL_H + GAP),
+        };
+        let title = format!(
+            "{label}: {} queries, T = {}, WL_T = {:.3}",
+            run.queries.len(),
+            run.t_final,
+            wl.last().copied().unwrap_or(wl0)
+        );
+        p.frame(&mut out, &title, "WL_t");
+        p.item_starts(&mut out, run);
+        let pts: Vec<(f64, f64)> = wl.iter().enumerate().map(|(t, y)| (t as f64, *y)).collect();
+        p.polyline(&mut out, &pts, "#1f5fbf", false);
+        p.queries(&mut out, run, wl);
+    }
+    out.push_str("</svg>\n");
+    Ok(out)
+}

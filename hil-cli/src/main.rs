@@ -22,6 +22,8 @@ struct Cli {
 enum Command {
     /// Run an experiment described by a TOML config.
     Run(cmd::run::RunArgs),
+    /// Generate or check food datasets.
+    Data(cmd::data::DataArgs),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +36,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Data(args) => cmd::data::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -22,6 +22,7 @@ pub mod dataset;
 pub mod env;
 pub mod generate;
 pub mod npy;
+pub mod output;
 pub mod plot;
 pub mod protocol;
 pub mod published;

@@ -160,6 +160,23 @@ fn protocol_runs_selects_on_validation_and_is_deterministic() {
     let slow = res.row("slow", 0.4, Family::LinucbQg);
     assert!(slow.is_none()); // 0.4 is not in w_tasks; selection still ran for the cross row
     assert_eq!(c.test.n_runs, 3);
+    let dir = std::env::temp_dir().join(format!("hil-envs-out-{}", std::process::id()));
+    let w = hil_envs::output::write_outputs(
+        &dir,
+        &res,
+        &recs,
+        &models,
+        "fast",
+        0.9,
+        &Default::default(),
+    )
+    .unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&w.results).unwrap()).unwrap();
+    assert_eq!(v["rows"].as_array().unwrap().len(), 16);
+    assert!(v["provenance"].is_string() && v["timing"].is_object());
+    assert_eq!(w.figures.len(), 2);
+    std::fs::remove_dir_all(&dir).unwrap();
     let md = hil_envs::report::tables_markdown(&res, Some(1.0));
     assert!(md.contains("synthetic") || md.contains("test data"));
     assert!(md.contains("Cross-data"));

@@ -244,3 +244,17 @@ fn plots_render_runs() {
         hil_envs::plot::workload_comparison_svg(&[("a", &rec), ("b", &rec)], m, 0.5, "n").unwrap();
     assert_eq!(svg.matches("<polyline").count(), 2);
 }
+
+#[test]
+fn paper_protocol_config_file_matches_the_built_in_settings() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/configs/paper-protocol.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let parsed: ProtocolSettings = hil_core::config::parse_toml(&text, &path).unwrap();
+    assert_eq!(parsed, ProtocolSettings::paper());
+    let bad = text.replace("n_seeds = 3", "n_seeds = 3\nn_seed = 2");
+    let e = hil_core::config::parse_toml::<ProtocolSettings>(&bad, &path)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("n_seed"), "{e}");
+}

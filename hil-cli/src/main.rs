@@ -22,6 +22,8 @@ struct Cli {
 enum Command {
     /// Run an experiment described by a TOML config.
     Run(cmd::run::RunArgs),
+    /// Workload study data and models: generate, select, fit, rollout, bundle.
+    Workload(cmd::workload::WorkloadArgs),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +36,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Workload(args) => cmd::workload::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -14,8 +14,9 @@
 //! Workload process (latent, on the [0, 1] scale, before Likert rounding):
 //! `participant level + population shift + condition effect + query-kind
 //! effects + decaying carry-over of recent queries + noise`; the baseline
-//! surveys share only part of the participant level (the paper's Constant
-//! baseline is worse than Average, so WL_0 is a weak predictor). Each TLX
+//! surveys share the participant level but add a large baseline-only
+//! spread and sit lower (the paper's Constant baseline is worse than
+//! Average, so WL_0 must be a noisy, biased predictor of later workload). Each TLX
 //! subscale adds its own noise and is rounded to the 5-point scale.
 //! [`SynthParams`] holds the calibrated values; see the crate README for
 //! the figures they reproduce.
@@ -69,19 +70,19 @@ impl Default for SynthParams {
     fn default() -> Self {
         Self {
             mean: 0.36,
-            population_shift: 0.05,
-            participant_sd: 0.17,
-            baseline_share: 0.35,
-            baseline_sd: 0.2,
-            baseline_offset: -0.1,
+            population_shift: 0.03,
+            participant_sd: 0.24,
+            baseline_share: 1.0,
+            baseline_sd: 0.37,
+            baseline_offset: -0.27,
             difficulty: [-0.06, 0.06],
             response: [-0.12, 0.0, 0.12],
-            distraction: [-0.08, 0.0, 0.08],
+            distraction: [-0.06, 0.0, 0.06],
             carry: 0.02,
             carry_tau_s: 90.0,
             condition_sd: 0.06,
-            survey_sd: 0.12,
-            item_sd: 0.12,
+            survey_sd: 0.13,
+            item_sd: 0.1,
         }
     }
 }

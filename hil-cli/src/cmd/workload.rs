@@ -29,6 +29,9 @@ enum WorkloadCommand {
         /// Random seed.
         #[arg(long, default_value_t = hil_workload::bundle::STUDY_SEED)]
         seed: u64,
+        /// Generator settings as JSON (a `SynthConfig`; default: the calibrated one).
+        #[arg(long)]
+        config: Option<PathBuf>,
         /// Print nothing.
         #[arg(long, short)]
         quiet: bool,
@@ -132,8 +135,20 @@ const SYNTHETIC: &str = "Data: synthetic study calibrated to the paper's publish
 /// Runs `hil workload`.
 pub fn run(args: WorkloadArgs) -> Result<()> {
     match args.command {
-        WorkloadCommand::Generate { out, seed, quiet } => {
-            let study = SynthConfig::default().generate(seed)?;
+        WorkloadCommand::Generate { out, seed, config, quiet } => {
+            let cfg = match config {
+                Some(path) => {
+                    let text = std::fs::read_to_string(&path).map_err(|e| HilError::io("reading", &path, e))?;
+                    serde_json::from_str::<SynthConfig>(&text).map_err(|e| HilError::Data {
+                        path: path.clone(),
+                        record: e.line(),
+                        field: "(json)".into(),
+                        why: e.to_string(),
+                    })?
+                }
+                None => SynthConfig::default(),
+            };
+            let study = cfg.generate(seed)?;
             write(&out, &study.to_csv())?;
             if !quiet {
                 println!("wrote {} ({} surveys)", out.display(), study.records().len());

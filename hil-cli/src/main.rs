@@ -24,6 +24,8 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Generate or check food datasets.
     Data(cmd::data::DataArgs),
+    /// Workload study data and models: generate, select, fit, rollout, bundle.
+    Workload(cmd::workload::WorkloadArgs),
 }
 
 fn main() -> ExitCode {
@@ -37,6 +39,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Data(args) => cmd::data::run(args),
+        Command::Workload(args) => cmd::workload::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

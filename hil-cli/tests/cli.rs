@@ -14,7 +14,10 @@ fn version_and_help() {
     let out = hil(&["--version"]);
     assert!(out.status.success());
     let v = String::from_utf8_lossy(&out.stdout);
-    assert!(v.starts_with("hil ") && v.contains(env!("CARGO_PKG_VERSION")), "{v}");
+    assert!(
+        v.starts_with("hil ") && v.contains(env!("CARGO_PKG_VERSION")),
+        "{v}"
+    );
 
     let out = hil(&["--help"]);
     assert!(out.status.success());

@@ -18,7 +18,11 @@ fn unsafe_only_in_the_plugin_loader() {
     let core = Path::new(env!("CARGO_MANIFEST_DIR")).join("../hil-core/src");
     let mut files = Vec::new();
     rust_files(&core, &mut files);
-    assert!(files.len() > 10, "hil-core sources not found at {}", core.display());
+    assert!(
+        files.len() > 10,
+        "hil-core sources not found at {}",
+        core.display()
+    );
     let mut offenders = Vec::new();
     for f in files {
         let rel = f.strip_prefix(&core).unwrap().to_string_lossy().to_string();
@@ -34,5 +38,8 @@ fn unsafe_only_in_the_plugin_loader() {
             }
         }
     }
-    assert!(offenders.is_empty(), "unsafe outside hil-core/src/plugin: {offenders:#?}");
+    assert!(
+        offenders.is_empty(),
+        "unsafe outside hil-core/src/plugin: {offenders:#?}"
+    );
 }

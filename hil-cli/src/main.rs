@@ -24,6 +24,8 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Generate or check food datasets.
     Data(cmd::data::DataArgs),
+    /// Rerun the paper's simulated experiments: results.json, tables.md, SVG figures.
+    Reproduce(cmd::reproduce::ReproduceArgs),
     /// Workload study data and models: generate, select, fit, rollout, bundle.
     Workload(cmd::workload::WorkloadArgs),
 }
@@ -39,6 +41,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Data(args) => cmd::data::run(args),
+        Command::Reproduce(args) => cmd::reproduce::run(args),
         Command::Workload(args) => cmd::workload::run(args),
     };
     match result {

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
 pub mod data;
+pub mod reproduce;
 pub mod run;
 pub mod workload;

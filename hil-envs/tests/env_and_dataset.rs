@@ -13,7 +13,7 @@ use hil_envs::{DatasetReplayEnv, FoodSplit, OutcomeMode};
 fn small() -> Arc<FoodDataset> {
     Arc::new(
         SyntheticFoods {
-            dim: 130,
+            dim: 224,
             images_per_setting: 3,
             ..SyntheticFoods::default()
         }
@@ -121,7 +121,7 @@ fn out_of_order_calls_are_errors() {
 fn save_then_load_round_trips_with_outcomes() {
     let mut ds = (*small()).clone();
     ds.foods.truncate(3);
-    ds.foods[1].images[0].context = hil_core::Context::new(vec![0.5; 130]).unwrap();
+    ds.foods[1].images[0].context = hil_core::Context::new(vec![0.5; 224]).unwrap();
     for img in &mut ds.foods[2].images {
         img.outcomes = Some((0..6).map(|a| vec![a % 2 == 0, true]).collect());
     }
@@ -155,7 +155,7 @@ fn edit_array(path: &Path, f: impl FnOnce(&mut NpyArray)) {
 fn loader_errors_name_file_record_and_field() {
     let e = load_error("nan", |d| {
         edit_array(&d.join("apple/contexts.npy"), |a| {
-            a.data[130 * 4 + 7] = f64::NAN
+            a.data[224 * 4 + 7] = f64::NAN
         })
     });
     assert!(
@@ -175,7 +175,7 @@ fn loader_errors_name_file_record_and_field() {
         let m = std::fs::read_to_string(d.join("dataset.toml")).unwrap();
         std::fs::write(
             d.join("dataset.toml"),
-            m.replace("context_dim = 130", "context_dim = 128"),
+            m.replace("context_dim = 224", "context_dim = 128"),
         )
         .unwrap();
     });

@@ -62,7 +62,7 @@ impl Policy for Simple {
 fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
     let ds = Arc::new(
         SyntheticFoods {
-            dim: 128,
+            dim: 224,
             images_per_setting: 2,
             ..SyntheticFoods::default()
         }
@@ -97,7 +97,7 @@ fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
 fn factory(spec: &PolicySpec) -> Result<Box<dyn Policy>> {
     Ok(Box::new(Simple {
         spec: *spec,
-        dim: 128,
+        dim: 224,
         rng: ChaCha8Rng::seed_from_u64(0),
     }))
 }

@@ -41,6 +41,10 @@ pub struct GenerateArgs {
     /// Images per food and setting.
     #[arg(long)]
     pub images_per_setting: Option<usize>,
+    /// Generator parameters (TOML, fields of `hil_envs::generate::SyntheticFoods`;
+    /// missing fields take the bundled dataset's values). Flags override it.
+    #[arg(long)]
+    pub generator: Option<PathBuf>,
     /// Overwrite a non-empty output directory.
     #[arg(long)]
     pub force: bool,
@@ -61,7 +65,13 @@ pub fn run(args: DataArgs) -> hil_core::Result<()> {
 }
 
 fn generate(a: GenerateArgs) -> hil_core::Result<()> {
-    let mut g = SyntheticFoods::default();
+    let mut g = match &a.generator {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| HilError::io("reading", p, e))?;
+            hil_core::config::parse_toml::<SyntheticFoods>(&text, p)?
+        }
+        None => SyntheticFoods::default(),
+    };
     if let Some(s) = a.seed {
         g.seed = s;
     }

@@ -164,9 +164,13 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         settings.w_tasks[0]
     };
     // Write once to measure, then again with the report time included.
-    write_outputs(&args.out, &results, &records, &models, plot_model, plot_w, &timing)?;
+    write_outputs(
+        &args.out, &results, &records, &models, plot_model, plot_w, &timing,
+    )?;
     timing.report_s = t2.elapsed().as_secs_f64();
-    let written = write_outputs(&args.out, &results, &records, &models, plot_model, plot_w, &timing)?;
+    let written = write_outputs(
+        &args.out, &results, &records, &models, plot_model, plot_w, &timing,
+    )?;
 
     if !args.quiet {
         eprintln!(

@@ -15,8 +15,10 @@
 //!   emits one [`StepEvent`] per step; [`EpisodeMetrics`] computes the
 //!   paper's metrics from those events.
 //! - Configs: [`config::ExperimentConfig`], with errors naming file, line and field.
+//! - Plugins: [`plugin`] loads types from shared libraries ([`declare_plugin!`]).
 //! - Conformance suites for implementers: `hil_core::testing` (feature `testing`).
-#![forbid(unsafe_code)]
+// Only the plugin loader may use `unsafe` (it allows it locally).
+#![deny(unsafe_code)]
 
 pub mod action;
 pub mod channel;
@@ -27,6 +29,7 @@ pub mod environment;
 pub mod error;
 pub mod experiment;
 pub mod metrics;
+pub mod plugin;
 pub mod policy;
 pub mod query;
 pub mod session;

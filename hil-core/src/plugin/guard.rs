@@ -122,6 +122,18 @@ fn drop_guarded<T>(inner: Option<T>) {
     let _ = catch_unwind(AssertUnwindSafe(move || drop(inner)));
 }
 
+/// Reads values to cache from a new object; if that panics, the object is
+/// dropped under the guard too and the panic is the error.
+fn cache<O, T>(guard: &Guard, method: &str, inner: O, f: impl FnOnce(&O) -> T) -> Result<(O, T)> {
+    match guard.run(method, || Ok(f(&inner))) {
+        Ok(v) => Ok((inner, v)),
+        Err(e) => {
+            drop_guarded(Some(inner));
+            Err(e)
+        }
+    }
+}
+
 /// A plugin [`Policy`] behind a panic guard.
 pub struct GuardedPolicy {
     inner: Option<Box<dyn Policy>>,
@@ -144,8 +156,8 @@ impl GuardedPolicy {
     /// Wraps `inner`, caching its name and shape (a panic there is an error).
     pub fn new(inner: Box<dyn Policy>, library: PathBuf, type_name: &str) -> Result<Self> {
         let guard = Guard::new(library, type_name);
-        let (name, n_arms, dim) = guard.run("name/n_arms/dim", || {
-            Ok((inner.name().to_string(), inner.n_arms(), inner.dim()))
+        let (inner, (name, n_arms, dim)) = cache(&guard, "name/n_arms/dim", inner, |p| {
+            (p.name().to_string(), p.n_arms(), p.dim())
         })?;
         Ok(Self {
             inner: Some(inner),
@@ -218,13 +230,14 @@ impl GuardedEnvironment {
     /// Wraps `inner`, caching its name, action space and context dimension.
     pub fn new(inner: Box<dyn Environment>, library: PathBuf, type_name: &str) -> Result<Self> {
         let guard = Guard::new(library, type_name);
-        let (name, actions, dim) = guard.run("name/action_space/context_dim", || {
-            Ok((
-                inner.name().to_string(),
-                inner.action_space().clone(),
-                inner.context_dim(),
-            ))
-        })?;
+        let (inner, (name, actions, dim)) =
+            cache(&guard, "name/action_space/context_dim", inner, |e| {
+                (
+                    e.name().to_string(),
+                    e.action_space().clone(),
+                    e.context_dim(),
+                )
+            })?;
         Ok(Self {
             inner: Some(inner),
             guard,
@@ -297,7 +310,7 @@ impl GuardedWorkload {
     /// Wraps `inner`, caching its name.
     pub fn new(inner: Box<dyn WorkloadModel>, library: PathBuf, type_name: &str) -> Result<Self> {
         let guard = Guard::new(library, type_name);
-        let name = guard.run("name", || Ok(inner.name().to_string()))?;
+        let (inner, name) = cache(&guard, "name", inner, |o| o.name().to_string())?;
         Ok(Self {
             inner: Some(inner),
             guard,
@@ -354,7 +367,7 @@ impl GuardedChannel {
     /// Wraps `inner`, caching its name.
     pub fn new(inner: Box<dyn QueryChannel>, library: PathBuf, type_name: &str) -> Result<Self> {
         let guard = Guard::new(library, type_name);
-        let name = guard.run("name", || Ok(inner.name().to_string()))?;
+        let (inner, name) = cache(&guard, "name", inner, |o| o.name().to_string())?;
         Ok(Self {
             inner: Some(inner),
             guard,

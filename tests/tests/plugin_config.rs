@@ -70,7 +70,11 @@ fn an_experiment_made_only_of_plugins_builds_and_runs() {
     assert!(summary.episodes.iter().all(|m| m.n_items == 5));
     // Same config, same seed: the same results.
     let cfg = ExperimentConfig::parse(&text, Path::new("exp.toml")).unwrap();
-    let again = cfg.build(Path::new(".")).unwrap().run(&mut [], |_, _| {}).unwrap();
+    let again = cfg
+        .build(Path::new("."))
+        .unwrap()
+        .run(&mut [], |_, _| {})
+        .unwrap();
     assert_eq!(
         serde_json::to_value(&summary).unwrap(),
         serde_json::to_value(&again).unwrap()
@@ -103,7 +107,11 @@ fn a_missing_plugin_is_located_in_the_config() {
 fn an_unknown_type_suggests_plugin_names_at_its_line() {
     let text = experiment(&all()).replace("\"linear_thompson\"", "\"linear_thomson\"");
     let e = ExperimentConfig::parse(&text, Path::new("exp.toml")).unwrap_err();
-    assert_eq!((e.line, e.field.as_deref()), (13, Some("policy.type")), "{e}");
+    assert_eq!(
+        (e.line, e.field.as_deref()),
+        (13, Some("policy.type")),
+        "{e}"
+    );
     assert!(e.to_string().contains("closest: `linear_thompson`"), "{e}");
 }
 

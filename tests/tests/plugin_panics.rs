@@ -6,8 +6,8 @@ mod common;
 
 use hil_core::plugin::{self, Params};
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Context, DecisionInput, Environment, Feedback, HilError,
-    Item, Policy, Query, QueryChannel, QueryHistory, QueryKind, WorkloadForecast, WorkloadModel,
+    ActionSpace, ArmId, BuildContext, Context, DecisionInput, Feedback, HilError, Item, Policy,
+    Query, QueryHistory, QueryKind, WorkloadForecast,
 };
 
 fn load() {

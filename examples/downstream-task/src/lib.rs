@@ -16,6 +16,7 @@
 //! ```
 //! use hil_core::config::EnvironmentConfig;
 //! use hil_core::BuildContext;
+//! hil_example_downstream_task::link();
 //! let cfg: Box<dyn EnvironmentConfig> = toml::from_str("type = \"cup_handover\"\nhandovers = 4").unwrap();
 //! let env = cfg.build(&BuildContext::new(".", 0)).unwrap();
 //! assert_eq!(env.action_space().len(), 5);

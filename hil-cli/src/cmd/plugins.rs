@@ -85,7 +85,8 @@ fn list(paths: &[PathBuf], json: bool) -> hil_core::Result<()> {
         }
     }
     if json {
-        let text = serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("plugin list", e))?;
+        let text =
+            serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("plugin list", e))?;
         println!("{text}");
     }
     if failed > 0 {
@@ -128,9 +129,9 @@ fn parse_params(specs: &[String], info: &PluginInfo) -> hil_core::Result<Vec<(St
     specs
         .iter()
         .map(|s| {
-            let (name, text) = s.split_once('=').ok_or_else(|| {
-                HilError::invalid_parameter("--params", s, "expected NAME=TEXT")
-            })?;
+            let (name, text) = s
+                .split_once('=')
+                .ok_or_else(|| HilError::invalid_parameter("--params", s, "expected NAME=TEXT"))?;
             if !info.components.iter().any(|c| c.name == name) {
                 let names: Vec<&str> = info.components.iter().map(|c| c.name.as_str()).collect();
                 return Err(HilError::invalid_parameter(
@@ -160,7 +161,11 @@ fn check(
     attempts: u32,
 ) -> hil_core::Result<()> {
     if dim == 0 {
-        return Err(HilError::invalid_parameter("--dim", 0, "must be at least 1"));
+        return Err(HilError::invalid_parameter(
+            "--dim",
+            0,
+            "must be at least 1",
+        ));
     }
     let info = plugin::load(path)?;
     let params = parse_params(specs, &info)?;
@@ -216,10 +221,9 @@ fn check_one(
     let name = c.name.as_str();
     let r = match c.kind {
         ComponentKind::Policy => check_policy(&|| plugin::build_policy(name, params, &ctx)),
-        ComponentKind::Environment => check_environment(
-            &|| plugin::build_environment(name, params, &ctx),
-            attempts,
-        ),
+        ComponentKind::Environment => {
+            check_environment(&|| plugin::build_environment(name, params, &ctx), attempts)
+        }
         ComponentKind::WorkloadModel => {
             let m = plugin::build_workload_model(name, params, &ctx).map_err(|e| e.to_string())?;
             check_workload_model(m.as_ref())

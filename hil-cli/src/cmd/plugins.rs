@@ -236,3 +236,60 @@ fn check_one(
     };
     r.map_err(|e| e.to_string())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
+
+    fn libs() -> PathBuf {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .parent()
+            .expect("hil-cli sits in the workspace root")
+            .to_path_buf();
+        build_cdylibs(
+            &root,
+            &[
+                "hil-example-plugin-guide",
+                "hil-test-plugin-panicky",
+                "hil-test-plugin-mismatched-abi",
+            ],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn check_passes_a_conforming_plugin_and_fails_a_broken_one() {
+        let dir = libs();
+        let guide = cdylib_path(&dir, "hil-example-plugin-guide");
+        check(&guide, &["ask_first_items=n_ask = 1".into()], 8, 30, 3).unwrap();
+        // Without its required parameter the factory refuses: a failure.
+        let e = check(&guide, &[], 8, 30, 3).unwrap_err();
+        assert!(e.to_string().contains("1 of 1 types failed"), "{e}");
+        // The panicky test plugin's components do not validate their inputs.
+        let e = check(&cdylib_path(&dir, "hil-test-plugin-panicky"), &[], 8, 30, 3).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("types failed their conformance suite"),
+            "{e}"
+        );
+        // Parameters for a type the library does not register.
+        let e = check(&guide, &["ask_first_item=n_ask = 1".into()], 8, 30, 3).unwrap_err();
+        assert!(e.to_string().contains("closest: ask_first_items"), "{e}");
+    }
+
+    #[test]
+    fn list_reports_every_library_and_fails_if_any_is_refused() {
+        let dir = libs();
+        list(&[cdylib_path(&dir, "hil-example-plugin-guide")], true).unwrap();
+        let e = list(
+            &[
+                cdylib_path(&dir, "hil-example-plugin-guide"),
+                cdylib_path(&dir, "hil-test-plugin-mismatched-abi"),
+            ],
+            false,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("1 of 2 libraries"), "{e}");
+    }
+}

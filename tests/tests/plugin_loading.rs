@@ -74,6 +74,15 @@ fn a_hil_core_version_mismatch_names_both_versions() {
         w.contains(&format!("host \"{}\"", env!("CARGO_PKG_VERSION"))),
         "{w}"
     );
+    assert!(
+        w.contains(&format!(
+            "interface layout: plugin \"0000000000000001\", host \"{:016x}\"",
+            plugin::interface_layout()
+        )),
+        "{w}"
+    );
+    // The facts that agree are not listed.
+    assert!(!w.contains("rustc version"), "{w}");
     assert!(!plugin::is_registered(
         ComponentKind::WorkloadModel,
         "never_registered"
@@ -156,7 +165,8 @@ fn list_reports_the_build_facts() {
             "hil-core version",
             "rustc version",
             "target",
-            "build profile"
+            "build profile",
+            "interface layout"
         ]
     );
     assert_eq!(info.components[0].kind, ComponentKind::QueryChannel);

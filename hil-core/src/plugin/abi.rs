@@ -11,6 +11,11 @@ use super::registrar::PluginRegistrar;
 /// [`PluginRegistrar`] trait and the factory signatures. Bumped on any change.
 pub const ABI_VERSION: u32 = 1;
 
+// The header's first fields must never move: hosts of every ABI version read
+// them from plugins of every other.
+const _: () = assert!(std::mem::offset_of!(PluginHeader, magic) == 0);
+const _: () = assert!(std::mem::offset_of!(PluginHeader, abi_version) == 8);
+
 /// The symbol every plugin exports (see [`crate::declare_plugin!`]).
 pub const DECLARATION_SYMBOL: &str = "HIL_PLUGIN_DECLARATION";
 
@@ -87,6 +92,61 @@ pub struct BuildFacts {
     pub target: FixedStr,
     /// Cargo profile hil-core was built with (`debug` or `release`).
     pub profile: FixedStr,
+    /// A fingerprint of the sizes and alignments of every type that crosses
+    /// the boundary, see [`interface_layout`]. Catches a plugin whose
+    /// dependencies (e.g. serde_json's version or features) lay those types
+    /// out differently even though the versions above agree.
+    pub interface_layout: u64,
+}
+
+/// FNV-1a over the size and alignment of every type passed between host
+/// and plugin (arguments, results, errors, registrar values).
+pub const fn interface_layout() -> u64 {
+    use std::mem::{align_of, size_of};
+    macro_rules! layouts {
+        ($($t:ty),* $(,)?) => {
+            [$((size_of::<$t>(), align_of::<$t>())),*]
+        };
+    }
+    let layouts = layouts![
+        crate::HilError,
+        crate::Result<()>,
+        serde_json::Value,
+        crate::BuildContext,
+        crate::Context,
+        crate::ActionSpace,
+        crate::Item,
+        crate::Query,
+        crate::Response,
+        crate::Decision,
+        crate::Outcome,
+        crate::DecisionInput<'static>,
+        crate::Feedback<'static>,
+        crate::QueryHistory,
+        crate::QueryKind,
+        crate::LabelledObservation,
+        super::registrar::Params,
+        super::registrar::Factory,
+        Box<dyn crate::Policy>,
+        std::path::PathBuf,
+    ];
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut i = 0;
+    while i < layouts.len() {
+        let words = [layouts[i].0 as u64, layouts[i].1 as u64];
+        let mut w = 0;
+        while w < 2 {
+            let mut b = 0;
+            while b < 8 {
+                hash ^= (words[w] >> (8 * b)) & 0xff;
+                hash = hash.wrapping_mul(0x0100_0000_01b3);
+                b += 1;
+            }
+            w += 1;
+        }
+        i += 1;
+    }
+    hash
 }
 
 impl BuildFacts {
@@ -97,16 +157,21 @@ impl BuildFacts {
             rustc_version: FixedStr::new(env!("HIL_CORE_RUSTC_VERSION")),
             target: FixedStr::new(env!("HIL_CORE_TARGET")),
             profile: FixedStr::new(env!("HIL_CORE_PROFILE")),
+            interface_layout: interface_layout(),
         }
     }
 
     /// The facts as `(name, value)` pairs, in the order they are checked.
-    pub fn fields(&self) -> [(&'static str, String); 4] {
+    pub fn fields(&self) -> [(&'static str, String); 5] {
         [
             ("hil-core version", self.hil_core_version.to_string_lossy()),
             ("rustc version", self.rustc_version.to_string_lossy()),
             ("target", self.target.to_string_lossy()),
             ("build profile", self.profile.to_string_lossy()),
+            (
+                "interface layout",
+                format!("{:016x}", self.interface_layout),
+            ),
         ]
     }
 }

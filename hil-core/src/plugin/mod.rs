@@ -7,7 +7,8 @@
 //!
 //! 1. a header read before anything else is trusted: a magic tag and the
 //!    [`ABI_VERSION`], then the panic strategy, hil-core version, rustc
-//!    version, target triple and build profile, captured at build time. A
+//!    version, target triple, build profile and a fingerprint of the layouts
+//!    of the types that cross the boundary, captured at build time. A
 //!    plugin is refused, with both sides' values, unless all of them equal
 //!    the host's;
 //! 2. a `register` function that adds named factories to a host-owned
@@ -61,7 +62,7 @@ mod registry;
 
 pub use abi::{
     ABI_VERSION, BuildFacts, DECLARATION_SYMBOL, FIXED_STR_LEN, FixedStr, MAGIC, PluginDeclaration,
-    PluginHeader, RegisterFn,
+    PluginHeader, RegisterFn, interface_layout,
 };
 pub use config::PluginComponent;
 pub(crate) use config::{component, optional_component};

@@ -1,5 +1,5 @@
-//! A plugin claiming another hil-core version: hosts must refuse it,
-//! naming both versions.
+//! A plugin claiming another hil-core version and other type layouts: hosts
+//! must refuse it, naming both sides' values of each.
 
 use hil_core::plugin::{ABI_VERSION, BuildFacts, FixedStr, Registrar};
 
@@ -12,6 +12,7 @@ hil_core::__declare_plugin_with!(
     ABI_VERSION,
     BuildFacts {
         hil_core_version: FixedStr::new("0.0.1-mismatched"),
+        interface_layout: 1,
         ..BuildFacts::current()
     }
 );

@@ -41,7 +41,12 @@ fn bench(c: &mut Criterion) {
     .unwrap();
 
     let dim = 32;
-    let x = Context::new((0..dim).map(|i| (i as f64 * 0.37).sin()).collect::<Vec<_>>()).unwrap();
+    let x = Context::new(
+        (0..dim)
+            .map(|i| (i as f64 * 0.37).sin())
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
     let h = QueryHistory::new();
     let mut ctx = BuildContext::new(".", 3);
     ctx.action_space = Some(ActionSpace::feeding());

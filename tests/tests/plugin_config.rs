@@ -37,6 +37,10 @@ confidence = 0.7
 type = "fatigue"
 tau = 18.0
 
+[policy_workload]
+type = "fatigue"
+base = 0.1
+
 [channel]
 type = "noisy_expert"
 error = 0.2
@@ -65,6 +69,7 @@ fn an_experiment_made_only_of_plugins_builds_and_runs() {
     assert_eq!(exp.policy.name(), "linear_thompson");
     assert_eq!(exp.workload.name(), "fatigue");
     assert_eq!(exp.channel.name(), "noisy_expert");
+    assert_eq!(exp.forecast.as_ref().map(|f| f.name()), Some("fatigue"));
     let summary = exp.run(&mut [], |_, _| {}).unwrap();
     assert_eq!(summary.episodes.len(), 2);
     assert!(summary.episodes.iter().all(|m| m.n_items == 5));

@@ -1,9 +1,16 @@
 //! Building plugin libraries from tests.
 //!
 //! A test that loads a plugin should build it itself, with the cargo that
-//! runs the test, into the same target directory and profile, so a fresh
-//! clone needs nothing but `cargo test` and the plugin matches the host's
-//! build facts. Cargo's own lock serialises concurrent builds.
+//! runs the test and in the same profile, so a fresh clone needs nothing but
+//! `cargo test` and the plugin matches the host's build facts. Cargo's own
+//! lock serialises concurrent builds.
+//!
+//! The plugins go to their own target directory, `<target>/plugin-build`:
+//! built alone, a crate's dependencies get other features than in the
+//! `cargo test` that runs us, and cargo may give both builds the same file
+//! names. Sharing one directory would let the nested build overwrite
+//! libraries the outer `cargo test` links later (its doctests), so the first
+//! run pays for one extra build of hil-core and its dependencies instead.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -34,10 +41,11 @@ pub fn target_layout() -> Result<(PathBuf, String)> {
 }
 
 /// Runs `cargo build -p <crate>...` in `workspace` with the running test's
-/// target directory and profile; returns the directory holding the built
-/// libraries (use [`cdylib_path`] for a crate's file).
+/// profile, into `<target>/plugin-build`; returns the directory holding the
+/// built libraries (use [`cdylib_path`] for a crate's file).
 pub fn build_cdylibs(workspace: &Path, crates: &[&str]) -> Result<PathBuf> {
     let (target, profile) = target_layout()?;
+    let target = target.join("plugin-build");
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
     let mut cmd = Command::new(cargo);
     cmd.current_dir(workspace)

@@ -14,6 +14,8 @@
 //! - The loop: [`Session`] runs episodes with the paper's semantics and
 //!   emits one [`StepEvent`] per step; [`EpisodeMetrics`] computes the
 //!   paper's metrics from those events.
+//! - The interaction record: [`record`] logs every step durably and
+//!   resumes killed sessions.
 //! - Configs: [`config::ExperimentConfig`], with errors naming file, line and field.
 //! - Conformance suites for implementers: `hil_core::testing` (feature `testing`).
 #![forbid(unsafe_code)]
@@ -29,6 +31,7 @@ pub mod experiment;
 pub mod metrics;
 pub mod policy;
 pub mod query;
+pub mod record;
 pub mod session;
 pub mod time;
 pub mod workload;

@@ -12,11 +12,14 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use hil_core::config::{EnvironmentConfig, PolicyConfig};
+use std::sync::Arc;
+
+use hil_core::config::{EnvironmentConfig, PolicyConfig, WorkloadModelConfig};
 use hil_core::policy::{check_feedback, check_input};
 use hil_core::{
     ActionSpace, ArmDiagnostics, ArmId, BuildContext, Context, Decision, DecisionInput,
-    Diagnostics, Environment, Feedback, HilError, Item, Outcome, Policy, QueryKind, Result,
+    Diagnostics, Environment, Feedback, HilError, Item, Outcome, Policy, QueryHistory, QueryKind,
+    Result, Timestep, WorkloadModel,
 };
 
 /// Published success rates (VS0 VS90 TV0 TV90 TA0 TA90) of a few foods.
@@ -414,5 +417,54 @@ impl Policy for DemoLearner {
         rng.set_word_pos(word_pos);
         self.rng = rng;
         Ok(())
+    }
+}
+
+/// Config of the demo workload model, `type = "demo_counting"`:
+///
+/// ```toml
+/// [workload]
+/// type = "demo_counting"
+/// increment = 0.05   # each query in the window adds this
+/// window = 10        # timesteps a query keeps counting (H)
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DemoCounting {
+    /// Workload added per query in the window, in [0, 1].
+    pub increment: f64,
+    /// Number of timesteps a query counts for (at least 1).
+    pub window: u64,
+}
+
+#[typetag::serde(name = "demo_counting")]
+impl WorkloadModelConfig for DemoCounting {
+    fn build(&self, _ctx: &BuildContext) -> Result<Arc<dyn WorkloadModel>> {
+        if !(0.0..=1.0).contains(&self.increment) {
+            return Err(HilError::invalid_parameter(
+                "increment",
+                self.increment,
+                "must be in [0, 1]",
+            ));
+        }
+        if self.window == 0 {
+            return Err(HilError::invalid_parameter(
+                "window",
+                0,
+                "must be at least 1",
+            ));
+        }
+        Ok(Arc::new(*self))
+    }
+}
+
+/// WL_t = clamp(WL_0 + increment · (queries in the last `window` steps), 0, 1).
+impl WorkloadModel for DemoCounting {
+    fn name(&self) -> &str {
+        "demo_counting"
+    }
+    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
+        let n = history.recent(t, self.window).count();
+        Ok((wl0 + self.increment * n as f64).clamp(0.0, 1.0))
     }
 }

@@ -209,4 +209,9 @@ fn demo_components_conform() {
     })
     .unwrap();
     assert!(DemoPlate::new(&["pizza".into()], 1).is_err());
+    hil_core::testing::check_workload_model(&hil_channels::demo::DemoCounting {
+        increment: 0.05,
+        window: 10,
+    })
+    .unwrap();
 }

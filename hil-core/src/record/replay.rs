@@ -30,6 +30,10 @@ impl QueryChannel for ReplayChannel<'_> {
         self.inner.seed(seed);
     }
 
+    fn endpoint(&self) -> Option<String> {
+        self.inner.endpoint()
+    }
+
     fn ask(&mut self, query: &Query) -> Result<Response> {
         let Some((episode, t, _, line)) = self.logged.front() else {
             return self.inner.ask(query);

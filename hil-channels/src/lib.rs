@@ -5,7 +5,7 @@
 //! - [`SimulatedExpert`]: the paper's perfect expert, or an imperfect one
 //!   with an error rate, a decline rate and a response-time model
 //!   (`type = "simulated_expert"`).
-//! - `TerminalChannel`: an interactive prompt for researchers at a
+//! - [`TerminalChannel`]: an interactive prompt for researchers at a
 //!   terminal (`type = "terminal"`).
 //! - `WebChannel`: a page served on 127.0.0.1 for the person being fed,
 //!   on a phone or tablet, by touch, keyboard or single switch
@@ -17,9 +17,12 @@
 //! ones with a scripted person at the other end, in their tests).
 
 pub mod demo;
+pub mod present;
 pub mod simulated;
+pub mod terminal;
 
 pub use simulated::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
+pub use terminal::{TerminalChannel, TerminalChannelConfig};
 
 /// Does nothing; calling it keeps this crate (and its typetag registrations)
 /// linked into a binary that names its components only in configs.

@@ -7,7 +7,7 @@
 //!   (`type = "simulated_expert"`).
 //! - [`TerminalChannel`]: an interactive prompt for researchers at a
 //!   terminal (`type = "terminal"`).
-//! - `WebChannel`: a page served on 127.0.0.1 for the person being fed,
+//! - [`WebChannel`]: a page served on 127.0.0.1 for the person being fed,
 //!   on a phone or tablet, by touch, keyboard or single switch
 //!   (`type = "web"`).
 //! - [`demo`]: a small plate of foods and a simple learner, to try the
@@ -20,9 +20,11 @@ pub mod demo;
 pub mod present;
 pub mod simulated;
 pub mod terminal;
+pub mod web;
 
 pub use simulated::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
 pub use terminal::{TerminalChannel, TerminalChannelConfig};
+pub use web::{WebChannel, WebChannelConfig};
 
 /// Does nothing; calling it keeps this crate (and its typetag registrations)
 /// linked into a binary that names its components only in configs.

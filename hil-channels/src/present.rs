@@ -95,7 +95,7 @@ pub fn action_named_in(text: &str, actions: &ActionSpace) -> Option<ArmId> {
         .collect();
     let mut named = actions.arms().filter(|a| {
         let name = actions.names()[a.0].to_lowercase();
-        words.iter().any(|w| *w == name)
+        words.contains(&name)
     });
     match (named.next(), named.next()) {
         (Some(a), None) => Some(a),

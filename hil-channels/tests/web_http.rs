@@ -371,9 +371,7 @@ fn concurrent_requests_are_all_served() {
                     post(
                         addr,
                         &format!("/{token}/api/answer"),
-                        &format!(
-                            "Origin: http://evil.example\r\nContent-Type: application/json\r\n"
-                        ),
+                        "Origin: http://evil.example\r\nContent-Type: application/json\r\n",
                         &format!(r#"{{"id":{id},"answer":{{"type":"declined"}}}}"#),
                     )
                     .0

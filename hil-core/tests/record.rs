@@ -163,7 +163,7 @@ fn resuming_from_every_cut_point_gives_the_uninterrupted_log() {
     let mut start = 0;
     for (i, b) in bytes.iter().enumerate() {
         if *b == b'\n' {
-            cuts.push((start + i + 1) / 2);
+            cuts.push((start + i).div_ceil(2));
             cuts.push(i + 1);
             start = i + 1;
         }

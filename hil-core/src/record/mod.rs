@@ -236,8 +236,7 @@ pub fn run_recorded(
         episode: 0,
         path: path.clone(),
     };
-    for k in plan.start_episode..exp.episodes {
-        let seed = seeds[k];
+    for (k, &seed) in seeds.iter().enumerate().skip(plan.start_episode) {
         recorder.set_episode(k);
         channel.episode = k;
         let mut session = Session {

@@ -41,10 +41,12 @@ impl QueryChannelConfig for TerminalChannelConfig {
 /// `?` answers "I don't know" ([`Answer::Declined`]: the policy acts on its
 /// own). An invalid answer is explained and asked again.
 ///
-/// End of input (Ctrl-D) or `q` stops the session with an error saying so;
-/// Ctrl-C ends the process (the default signal behaviour). Either way every
-/// step answered before is already in the interaction log, and
-/// `hil run --resume LOG` asks the unanswered query again.
+/// End of input (Ctrl-D) or `q` stops the session with an error saying so.
+/// Ctrl-C is not seen by the channel: it interrupts the process (`hil run`
+/// then prints where the log is and how to resume, and exits with status
+/// 130). Either way every step answered before is already in the
+/// interaction log, and `hil run --resume LOG` asks the unanswered query
+/// again.
 ///
 /// Generic over its reader and writer so that it can be driven by tests:
 ///

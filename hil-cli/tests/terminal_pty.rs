@@ -36,6 +36,7 @@ type = "terminal"
 struct Outcome {
     answered: u64,
     exit_code: Option<i64>,
+    #[allow(dead_code)] // shown in failure messages
     signal: Option<i64>,
     output: String,
 }
@@ -98,7 +99,23 @@ fn answered_interrupted_and_resumed_through_a_pty() {
         ],
     );
     assert_eq!(first.answered, 2, "{}", first.output);
-    assert_eq!(first.signal, Some(2), "Ctrl-C ends the process: {first:?}");
+    assert_eq!(
+        first.exit_code,
+        Some(130),
+        "Ctrl-C ends the process: {first:?}"
+    );
+    assert!(
+        first
+            .output
+            .contains("interrupted: every answered step is in"),
+        "{}",
+        first.output
+    );
+    assert!(
+        first.output.contains("hil run --resume"),
+        "{}",
+        first.output
+    );
     assert!(
         first
             .output

@@ -88,7 +88,10 @@ fn web_run_prints_the_url_records_answers_and_timeouts() {
         let v: serde_json::Value = serde_json::from_str(&body).unwrap();
         if v["state"] == "query" {
             assert_eq!(v["item"]["label"], "banana");
-            assert_eq!(v["kind_text"], "multiple choice · easy question · no distraction");
+            assert_eq!(
+                v["kind_text"],
+                "multiple choice · easy question · no distraction"
+            );
             break v["id"].as_u64().unwrap();
         }
         assert!(Instant::now() < deadline, "no query");

@@ -97,6 +97,10 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
         }
     };
 
+    install_interrupt_notice(match &start {
+        Start::Fresh { log, .. } => log.clone(),
+        Start::Resume(log) => Some(log.clone()),
+    });
     let summary = match start {
         Start::Fresh { config, log } => {
             let text = std::fs::read_to_string(&config)
@@ -152,6 +156,37 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
     }
     print_summary(&summary, args.json, args.quiet)
 }
+
+/// On Ctrl-C (or SIGTERM), says what was kept and how to continue, then
+/// exits with status 130. Every step answered so far is already on disk
+/// (steps are fsync'ed before the robot acts); a line cut short by the
+/// interrupt is discarded by `--resume`.
+#[cfg(unix)]
+fn install_interrupt_notice(log: Option<PathBuf>) {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+        return; // the default behaviour (ending the process) still applies
+    };
+    let _ = std::thread::Builder::new()
+        .name("hil-interrupt".into())
+        .spawn(move || {
+            if signals.forever().next().is_some() {
+                match &log {
+                    Some(p) => eprintln!(
+                        "\ninterrupted: every answered step is in {0}; continue with `hil run --resume {0}`",
+                        p.display()
+                    ),
+                    None => eprintln!(
+                        "\ninterrupted: no interaction log was kept (run with --log LOG to be able to resume)"
+                    ),
+                }
+                std::process::exit(130);
+            }
+        });
+}
+
+#[cfg(not(unix))]
+fn install_interrupt_notice(_log: Option<PathBuf>) {}
 
 /// Tells the researcher where the person answers (a web channel's URL).
 /// Printed even with --quiet: without it nobody can answer.

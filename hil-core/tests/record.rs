@@ -304,3 +304,37 @@ fn a_finished_log_resumes_to_the_same_summary_without_running_anything() {
     assert_eq!(std::fs::read_to_string(&path).unwrap(), before);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_step_that_cannot_be_logged_stops_the_session_before_the_robot_acts() {
+    use hil_core::record::Recorder;
+    use hil_core::{ArmDiagnostics, Diagnostics, PendingStep, SessionObserver, StepDecision};
+    let dir = tmp_dir("nan");
+    let path = dir.join("log.jsonl");
+    let mut rec = Recorder::new(RecordLog::create(&path, header()).unwrap());
+    let step = PendingStep {
+        t: 1,
+        item_index: 0,
+        item_label: "kiwi".into(),
+        attempt: 0,
+        context: hil_core::Context::new(vec![0.0]).unwrap(),
+        decision: StepDecision::Act { arm: ArmId(0) },
+        diagnostics: Some(Diagnostics {
+            arms: vec![ArmDiagnostics {
+                estimate: f64::NAN,
+                bonus: 0.0,
+                ucb: 0.0,
+            }],
+            ..Default::default()
+        }),
+        response: None,
+        arm: ArmId(0),
+        wl: 0.5,
+    };
+    let err = rec.before_execute(&step).unwrap_err().to_string();
+    assert!(err.contains("non-finite"), "{err}");
+    // Nothing unreadable reached the log.
+    let (_, logged) = RecordLog::open(&path).unwrap();
+    assert!(logged.records.is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -72,6 +72,17 @@ impl Recorder {
     pub fn emit(&mut self, record: &Record) -> Result<()> {
         let mut text = serde_json::to_string(record)
             .map_err(|e| HilError::serde(format!("{} record", record.kind()), e))?;
+        // JSON has no NaN or infinity (serde_json writes them as null): a
+        // record that does not read back would make the log unresumable,
+        // so it stops the session before the robot acts.
+        if serde_json::from_str::<Record>(&text).is_err() {
+            return Err(HilError::invalid_input(
+                format!("{} record", record.kind()),
+                format!(
+                    "it contains a non-finite number (NaN or infinity) that a log cannot hold: {text}"
+                ),
+            ));
+        }
         if let Some(logged) = self.expected.pop_front() {
             if logged.text != text {
                 return Err(HilError::Data {

@@ -33,6 +33,7 @@ fn main() -> ExitCode {
     hil_workload::link();
     hil_envs::link();
     hil_kinova_mujoco::link();
+    hil_channels::link();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),

@@ -151,8 +151,15 @@ impl Browser {
                 Some(&json!({"using": "css selector", "value": css})),
             );
             if let Some(id) = r["value"][ELEMENT].as_str() {
-                let shown = self.cmd("GET", &format!("/element/{id}/displayed"), json!({}));
-                if shown == json!(true) {
+                // The page rebuilds its controls for each question: an
+                // element found a moment ago may be gone (stale); retry.
+                let shown = http(
+                    self.port,
+                    "GET",
+                    &format!("/session/{}/element/{id}/displayed", self.session),
+                    None,
+                );
+                if shown["value"] == json!(true) {
                     return id.to_string();
                 }
             }
@@ -419,6 +426,26 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     };
     assert!(
         (bbox.x0 - 2.0 / 3.0).abs() < 1e-9 && (bbox.y1 - 1.0).abs() < 1e-9,
+        "{bbox:?}"
+    );
+
+    // 4b. Bounding box by keyboard on the drawing area: arrows move a
+    // default box (0.4..0.6) by 2% a press, Shift+arrows resize it.
+    let asking = ask_async(ch, query(7, ResponseType::BoundingBox));
+    browser.find("#bbox-canvas");
+    browser.script("document.getElementById('bbox-canvas').focus();");
+    browser.keys(&["\u{E014}", "\u{E014}", "\u{E014}"]); // ArrowRight ×3
+    browser.click("#send-box");
+    let (ch, r) = asking.join().unwrap();
+    let Answer::BoundingBox { bbox } = r.answer else {
+        panic!("{:?}", r.answer)
+    };
+    assert!(
+        (bbox.x0 - 0.46).abs() < 1e-6 && (bbox.x1 - 0.66).abs() < 1e-6,
+        "{bbox:?}"
+    );
+    assert!(
+        (bbox.y0 - 0.4).abs() < 1e-6 && (bbox.y1 - 0.6).abs() < 1e-6,
         "{bbox:?}"
     );
 

@@ -311,6 +311,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     }
     let ch = WebChannel::start(WebChannelConfig {
         timeout_s: 60.0,
+        images: Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures")),
         ..Default::default()
     })
     .unwrap();
@@ -332,6 +333,26 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
         shown.contains("baby carrot: a baby carrot lying flat"),
         "{shown}"
     );
+    // The item's picture is shown, loaded, and described for screen readers.
+    let id = browser.find("#item-image");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let img = browser.script(
+            "const i = document.getElementById('item-image'); return [i.complete, i.naturalWidth, i.alt];",
+        );
+        if img[0] == json!(true) && img[1] == json!(1) {
+            assert_eq!(
+                img[2],
+                "Picture of the baby carrot: a baby carrot lying flat"
+            );
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "picture not loaded: {img} ({id})"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
     // Accessibility on the live page: every control has a name, contrast
     // is at least 4.5:1, targets are large.
     let audit = browser.script(

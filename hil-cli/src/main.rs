@@ -22,6 +22,8 @@ struct Cli {
 enum Command {
     /// Run an experiment described by a TOML config.
     Run(cmd::run::RunArgs),
+    /// Inspect plugin libraries and check their types for conformance.
+    Plugins(cmd::plugins::PluginsArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Plugins(args) => cmd::plugins::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

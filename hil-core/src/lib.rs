@@ -17,8 +17,10 @@
 //! - The interaction record: [`record`] logs every step durably and
 //!   resumes killed sessions.
 //! - Configs: [`config::ExperimentConfig`], with errors naming file, line and field.
+//! - Plugins: [`plugin`] loads types from shared libraries ([`declare_plugin!`]).
 //! - Conformance suites for implementers: `hil_core::testing` (feature `testing`).
-#![forbid(unsafe_code)]
+// Only the plugin loader may use `unsafe` (it allows it locally).
+#![deny(unsafe_code)]
 
 pub mod action;
 pub mod channel;
@@ -29,6 +31,7 @@ pub mod environment;
 pub mod error;
 pub mod experiment;
 pub mod metrics;
+pub mod plugin;
 pub mod policy;
 pub mod query;
 pub mod record;

@@ -151,8 +151,15 @@ impl Browser {
                 Some(&json!({"using": "css selector", "value": css})),
             );
             if let Some(id) = r["value"][ELEMENT].as_str() {
-                let shown = self.cmd("GET", &format!("/element/{id}/displayed"), json!({}));
-                if shown == json!(true) {
+                // The page rebuilds its controls for each question: an
+                // element found a moment ago may be gone (stale); retry.
+                let shown = http(
+                    self.port,
+                    "GET",
+                    &format!("/session/{}/element/{id}/displayed", self.session),
+                    None,
+                );
+                if shown["value"] == json!(true) {
                     return id.to_string();
                 }
             }
@@ -304,6 +311,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     }
     let ch = WebChannel::start(WebChannelConfig {
         timeout_s: 60.0,
+        images: Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures")),
         ..Default::default()
     })
     .unwrap();
@@ -325,6 +333,26 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
         shown.contains("baby carrot: a baby carrot lying flat"),
         "{shown}"
     );
+    // The item's picture is shown, loaded, and described for screen readers.
+    let id = browser.find("#item-image");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let img = browser.script(
+            "const i = document.getElementById('item-image'); return [i.complete, i.naturalWidth, i.alt];",
+        );
+        if img[0] == json!(true) && img[1] == json!(1) {
+            assert_eq!(
+                img[2],
+                "Picture of the baby carrot: a baby carrot lying flat"
+            );
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "picture not loaded: {img} ({id})"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
     // Accessibility on the live page: every control has a name, contrast
     // is at least 4.5:1, targets are large.
     let audit = browser.script(
@@ -419,6 +447,26 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     };
     assert!(
         (bbox.x0 - 2.0 / 3.0).abs() < 1e-9 && (bbox.y1 - 1.0).abs() < 1e-9,
+        "{bbox:?}"
+    );
+
+    // 4b. Bounding box by keyboard on the drawing area: arrows move a
+    // default box (0.4..0.6) by 2% a press, Shift+arrows resize it.
+    let asking = ask_async(ch, query(7, ResponseType::BoundingBox));
+    browser.find("#bbox-canvas");
+    browser.script("document.getElementById('bbox-canvas').focus();");
+    browser.keys(&["\u{E014}", "\u{E014}", "\u{E014}"]); // ArrowRight ×3
+    browser.click("#send-box");
+    let (ch, r) = asking.join().unwrap();
+    let Answer::BoundingBox { bbox } = r.answer else {
+        panic!("{:?}", r.answer)
+    };
+    assert!(
+        (bbox.x0 - 0.46).abs() < 1e-6 && (bbox.x1 - 0.66).abs() < 1e-6,
+        "{bbox:?}"
+    );
+    assert!(
+        (bbox.y0 - 0.4).abs() < 1e-6 && (bbox.y1 - 0.6).abs() < 1e-6,
         "{bbox:?}"
     );
 

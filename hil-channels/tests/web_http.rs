@@ -478,3 +478,72 @@ fn conforms_with_a_person_answering_over_http() {
     check_query_channel(&mut ch, 18).unwrap();
     person.join().unwrap();
 }
+
+#[test]
+fn item_pictures_are_served_for_the_open_question_only() {
+    let dir = std::env::temp_dir().join(format!("hil-web-images-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("cantaloupe.png"), "PNGDATA").unwrap();
+    std::fs::write(dir.join("secret.png"), "SECRET").unwrap();
+    let ch = WebChannel::start(WebChannelConfig {
+        timeout_s: 10.0,
+        images: Some(dir.clone()),
+        ..Default::default()
+    })
+    .unwrap();
+    let addr = ch.addr();
+    let token = ch
+        .url()
+        .trim_end_matches('/')
+        .rsplit('/')
+        .next()
+        .unwrap()
+        .to_string();
+    let asking = ask_async(ch, query(1, ResponseType::Mcq));
+    let id = open_id(addr, &token);
+    let (_, body) = get(addr, &format!("/{token}/api/query"));
+    let v: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(v["image"], format!("image/{id}"));
+    let (s, bytes) = get(addr, &format!("/{token}/image/{id}"));
+    assert_eq!((s, bytes.as_str()), (200, "PNGDATA"));
+    assert_eq!(get(addr, &format!("/{token}/image/{}", id + 1)).0, 404);
+    assert_eq!(get(addr, &format!("/{token}/image/../secret.png")).0, 404);
+    assert_eq!(get(addr, &format!("/x/image/{id}")).0, 403);
+    let (s, _) = post(
+        addr,
+        &format!("/{token}/api/answer"),
+        &same_origin(addr),
+        &format!(r#"{{"id":{id},"answer":{{"type":"declined"}}}}"#),
+    );
+    assert_eq!(s, 200);
+    let (mut ch, r) = asking.join().unwrap();
+    assert_eq!(r.answer, Answer::Declined);
+    // Labels that are not plain names never map to a file.
+    let mut q = query(2, ResponseType::Mcq);
+    q.item.label = "../secret".into();
+    let person = std::thread::spawn(move || {
+        let id = open_id(addr, &token);
+        let (_, body) = get(addr, &format!("/{token}/api/query"));
+        let v: serde_json::Value = serde_json::from_str(&body).unwrap();
+        assert!(v["image"].is_null(), "{v}");
+        post(
+            addr,
+            &format!("/{token}/api/answer"),
+            &same_origin(addr),
+            &format!(r#"{{"id":{id},"answer":{{"type":"declined"}}}}"#),
+        )
+        .0
+    });
+    ch.ask(&q).unwrap();
+    assert_eq!(person.join().unwrap(), 200);
+    drop(ch);
+    let err = WebChannel::start(WebChannelConfig {
+        images: Some(dir.join("missing")),
+        ..Default::default()
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("images") && err.contains("missing"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

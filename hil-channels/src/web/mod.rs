@@ -41,6 +41,7 @@ fn default_timeout() -> f64 {
 /// port = 8765            # default 0: any free port (the URL is printed)
 /// timeout_s = 120        # then the robot acts on its own (recorded as timed_out)
 /// allowed_hosts = []     # host names besides IP addresses and localhost
+/// images = "pictures"    # optional: <item label>.png/.jpg/.jpeg/.webp shown with the question
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -58,6 +59,11 @@ pub struct WebChannelConfig {
     /// IP addresses and `localhost` are always accepted.
     #[serde(default)]
     pub allowed_hosts: Vec<String>,
+    /// Directory of item pictures, named by item label (`banana.jpg`);
+    /// relative paths resolve against the config's directory. Items without
+    /// a picture are shown by their description.
+    #[serde(default)]
+    pub images: Option<std::path::PathBuf>,
 }
 
 impl Default for WebChannelConfig {
@@ -67,14 +73,17 @@ impl Default for WebChannelConfig {
             port: 0,
             timeout_s: DEFAULT_TIMEOUT_S,
             allowed_hosts: Vec::new(),
+            images: None,
         }
     }
 }
 
 #[typetag::serde(name = "web")]
 impl QueryChannelConfig for WebChannelConfig {
-    fn build(&self, _ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
-        Ok(Box::new(WebChannel::start(self.clone())?))
+    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
+        let mut config = self.clone();
+        config.images = config.images.map(|d| ctx.resolve(&d));
+        Ok(Box::new(WebChannel::start(config)?))
     }
 }
 
@@ -85,6 +94,8 @@ struct Pending {
     asked_at: Instant,
     deadline: Instant,
     answer: Option<(Answer, Option<ArmId>)>,
+    /// The item's picture and its content type, if there is one.
+    image: Option<(Vec<u8>, &'static str)>,
 }
 
 #[derive(Default)]
@@ -101,6 +112,7 @@ struct Shared {
     port: std::sync::OnceLock<u16>,
     allowed_hosts: Vec<String>,
     timeout: Duration,
+    images: Option<std::path::PathBuf>,
     state: Mutex<State>,
     answered: Condvar,
 }
@@ -173,6 +185,15 @@ impl WebChannel {
                 ));
             }
         }
+        if let Some(dir) = &config.images
+            && !dir.is_dir()
+        {
+            return Err(HilError::invalid_parameter(
+                "images",
+                dir.display(),
+                "is not a directory",
+            ));
+        }
         let token: String = rand::rng()
             .random::<[u8; 16]>()
             .iter()
@@ -190,6 +211,7 @@ impl WebChannel {
                 .map(|h| h.to_ascii_lowercase())
                 .collect(),
             timeout: Duration::from_secs_f64(config.timeout_s),
+            images: config.images.clone(),
             state: Mutex::new(State::default()),
             answered: Condvar::new(),
         });
@@ -238,6 +260,10 @@ impl QueryChannel for WebChannel {
     }
 
     fn ask(&mut self, query: &Query) -> Result<Response> {
+        let image = match &self.shared.images {
+            Some(dir) => load_image(dir, &query.item.label)?,
+            None => None,
+        };
         let mut state = self.shared.lock();
         let id = state.next_id;
         state.next_id += 1;
@@ -250,6 +276,7 @@ impl QueryChannel for WebChannel {
             asked_at,
             deadline,
             answer: None,
+            image,
         });
         loop {
             let answered = state
@@ -293,6 +320,45 @@ impl QueryChannel for WebChannel {
     }
 }
 
+/// Largest picture served, in bytes.
+const MAX_IMAGE_BYTES: u64 = 8 * 1024 * 1024;
+
+/// The picture of item `label` in `dir`, if there is one. Labels that are
+/// not plain names (letters, digits, `_`, `-`) never map to a file. SVG is
+/// not served: it can carry scripts.
+fn load_image(dir: &std::path::Path, label: &str) -> Result<Option<(Vec<u8>, &'static str)>> {
+    if label.is_empty()
+        || !label
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+    {
+        return Ok(None);
+    }
+    for (ext, content_type) in [
+        ("png", "image/png"),
+        ("jpg", "image/jpeg"),
+        ("jpeg", "image/jpeg"),
+        ("webp", "image/webp"),
+    ] {
+        let path = dir.join(format!("{label}.{ext}"));
+        if !path.is_file() {
+            continue;
+        }
+        let len = std::fs::metadata(&path)
+            .map_err(|e| HilError::io("reading", &path, e))?
+            .len();
+        if len > MAX_IMAGE_BYTES {
+            return Err(HilError::invalid_input(
+                format!("picture {}", path.display()),
+                format!("it has {len} bytes, more than the {MAX_IMAGE_BYTES} a page may show"),
+            ));
+        }
+        let bytes = std::fs::read(&path).map_err(|e| HilError::io("reading", &path, e))?;
+        return Ok(Some((bytes, content_type)));
+    }
+    Ok(None)
+}
+
 /// Short explanations of the feeding actions, shown under their names.
 fn action_hint(name: &str) -> Option<String> {
     let (pitch, roll) = name.split_at(name.len().min(2));
@@ -328,6 +394,7 @@ fn query_view(p: &Pending) -> Value {
         "actions": q.actions.names().iter().enumerate().map(|(i, n)| json!({
             "arm": i, "name": n, "hint": action_hint(n),
         })).collect::<Vec<_>>(),
+        "image": p.image.as_ref().map(|_| format!("image/{}", p.id)),
         "remaining_s": remaining.as_secs_f64(),
         "elapsed_s": p.asked_at.elapsed().as_secs_f64(),
     })
@@ -408,6 +475,20 @@ fn handle(shared: &Shared, req: &Request) -> HttpResponse {
             }
         }
         ("POST", "api/answer") => post_answer(shared, req),
+        ("GET", r) if r.starts_with("image/") => {
+            let state = shared.lock();
+            match &state.current {
+                Some(p) if r == format!("image/{}", p.id) && p.image.is_some() => {
+                    let (bytes, content_type) = p.image.as_ref().expect("checked");
+                    HttpResponse {
+                        status: 200,
+                        content_type,
+                        body: bytes.clone(),
+                    }
+                }
+                _ => HttpResponse::text(404, "no picture"),
+            }
+        }
         (_, "" | "app.js" | "app.css" | "api/query" | "api/answer") => {
             HttpResponse::text(405, "method not allowed")
         }

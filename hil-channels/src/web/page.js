@@ -7,6 +7,7 @@
   let current = null;     // the open question, as served by api/query
   let box = null;         // [x0, y0, x1, y1] in 0..1
   let drag = null;
+  let picture = null;     // the item's picture, when the server has one
   let scanTimer = null;
   let scanIndex = -1;
   let sending = false;
@@ -48,6 +49,19 @@
     $("kind").textContent = "Question type: " + q.kind_text;
     $("question").textContent = q.question;
     $("item").textContent = "Food: " + q.item.text;
+    const img = $("item-image");
+    picture = null;
+    if (q.image) {
+      img.alt = "Picture of the " + q.item.text;
+      img.src = q.image;
+      img.hidden = q.kind.response === "bounding_box";  // drawn on the canvas instead
+      const p = new Image();
+      p.onload = () => { picture = p; draw(); };
+      p.src = q.image;
+    } else {
+      img.hidden = true;
+      img.removeAttribute("src");
+    }
     $("query").hidden = false;
     $("mcq").hidden = q.kind.response !== "mcq";
     $("bbox").hidden = q.kind.response !== "bounding_box";
@@ -147,10 +161,15 @@
     const w = cv.width, h = cv.height;
     g.clearRect(0, 0, w, h);
     g.fillStyle = "#f4f1ea"; g.fillRect(0, 0, w, h);
-    // A plate, with the food named in the middle (no camera picture is sent).
-    g.fillStyle = "#ffffff"; g.strokeStyle = "#555555"; g.lineWidth = 3;
-    g.beginPath(); g.ellipse(w / 2, h / 2, w * 0.42, h * 0.42, 0, 0, 2 * Math.PI); g.fill(); g.stroke();
-    if (current) {
+    if (picture) {
+      // Box coordinates are relative to the picture, stretched to the canvas.
+      g.drawImage(picture, 0, 0, w, h);
+    } else {
+      // No picture: a plate, with the food named in the middle.
+      g.fillStyle = "#ffffff"; g.strokeStyle = "#555555"; g.lineWidth = 3;
+      g.beginPath(); g.ellipse(w / 2, h / 2, w * 0.42, h * 0.42, 0, 0, 2 * Math.PI); g.fill(); g.stroke();
+    }
+    if (current && !picture) {
       g.fillStyle = "#1a1a1a"; g.font = "bold 28px system-ui, sans-serif"; g.textAlign = "center";
       g.fillText(current.item.label, w / 2, h / 2 + 10);
     }

@@ -35,6 +35,13 @@
 //! outcome (killed while the robot acted) is executed again; in simulation
 //! that reproduces the same outcome.
 //!
+//! Replaying calls the environment again for the steps of the unfinished
+//! episode, so it needs an environment that is deterministic given its seed
+//! (every simulated one is). A physical robot would repeat those actions
+//! and observe new contexts, which the verification rejects: resuming
+//! real-robot sessions needs an environment-side replay mode, which does
+//! not exist yet.
+//!
 //! ```
 //! use hil_core::record::{Header, RecordLog, Recorder, Record};
 //! let dir = std::env::temp_dir().join(format!("hil-record-doc-{}", std::process::id()));

@@ -31,7 +31,14 @@ fn fitted(d: usize, arms: usize, per_arm: usize, r: RepresentationChoice) -> Lin
     e
 }
 
-fn step(c: &mut Criterion, name: &str, d: usize, arms: usize, per_arm: usize, r: RepresentationChoice) {
+fn step(
+    c: &mut Criterion,
+    name: &str,
+    d: usize,
+    arms: usize,
+    per_arm: usize,
+    r: RepresentationChoice,
+) {
     let base = fitted(d, arms, per_arm, r);
     let mut rng = ChaCha8Rng::seed_from_u64(2);
     let x = ctx(&mut rng, d);
@@ -48,8 +55,22 @@ fn step(c: &mut Criterion, name: &str, d: usize, arms: usize, per_arm: usize, r:
 }
 
 fn benches(c: &mut Criterion) {
-    step(c, "kernel_d2048_6arms_300each", 2048, 6, 300, RepresentationChoice::Kernel);
-    step(c, "dense_d1024_6arms_1000each", 1024, 6, 1000, RepresentationChoice::Dense);
+    step(
+        c,
+        "kernel_d2048_6arms_300each",
+        2048,
+        6,
+        300,
+        RepresentationChoice::Kernel,
+    );
+    step(
+        c,
+        "dense_d1024_6arms_1000each",
+        1024,
+        6,
+        1000,
+        RepresentationChoice::Dense,
+    );
 }
 
 criterion_group! {

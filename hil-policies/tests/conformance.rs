@@ -8,9 +8,8 @@ use hil_core::config::PolicyConfig;
 use hil_core::testing::check_policy;
 use hil_core::{ActionSpace, ArmId, BuildContext, Context, LabelledObservation, Policy, QueryKind};
 use hil_policies::{
-    AlwaysQuery, AlwaysQueryParams, EstimatorOptions, LinUcb, LinUcbExpDecay,
-    LinUcbExpDecayParams, LinUcbParams, LinUcbQg, LinUcbQgParams, LinearArms,
-    RepresentationChoice,
+    AlwaysQuery, AlwaysQueryParams, EstimatorOptions, LinUcb, LinUcbExpDecay, LinUcbExpDecayParams,
+    LinUcbParams, LinUcbQg, LinUcbQgParams, LinearArms, RepresentationChoice,
 };
 
 const DIM: usize = 5;
@@ -41,7 +40,9 @@ fn estimator(r: RepresentationChoice) -> LinearArms {
     arms
 }
 
-fn all_policies(r: RepresentationChoice) -> Vec<Box<dyn Fn() -> hil_core::Result<Box<dyn Policy>>>> {
+type Factory = dyn Fn() -> hil_core::Result<Box<dyn Policy>>;
+
+fn all_policies(r: RepresentationChoice) -> Vec<Box<Factory>> {
     let k = QueryKind::default();
     vec![
         Box::new(move || Ok(Box::new(LinUcb::new(LinUcbParams::new(0.8)?, estimator(r))))),
@@ -113,9 +114,15 @@ fn build(toml_text: &str, c: &BuildContext) -> Result<Box<dyn Policy>, String> {
 fn configs_build_every_policy() {
     let cases = [
         ("linucb", "alpha = 0.5"),
-        ("always_query", "alpha = 0.5\nquery_kind = { difficulty = \"hard\" }"),
+        (
+            "always_query",
+            "alpha = 0.5\nquery_kind = { difficulty = \"hard\" }",
+        ),
         ("linucb_exp_decay", "alpha = 0.5\nc = 0.2\nseed = 9"),
-        ("linucb_qg", "alpha = 0.5\nw = 0.2\nlambda = 2.0\n[policy.estimator]\nrepresentation = \"dense\""),
+        (
+            "linucb_qg",
+            "alpha = 0.5\nw = 0.2\nlambda = 2.0\n[policy.estimator]\nrepresentation = \"dense\"",
+        ),
     ];
     for (name, body) in cases {
         let text = format!("[policy]\ntype = \"{name}\"\npretrain = true\n{body}\n");
@@ -130,17 +137,38 @@ fn config_errors_name_the_value() {
     let c = ctx(false);
     let e = build_err("[policy]\ntype = \"linucb\"\nalpha = -1.0\n", &c);
     assert!(e.contains("alpha") && e.contains("-1"), "{e}");
-    let e = build_err("[policy]\ntype = \"linucb\"\nalpha = 1.0\nlambda = 0.0\n", &c);
+    let e = build_err(
+        "[policy]\ntype = \"linucb\"\nalpha = 1.0\nlambda = 0.0\n",
+        &c,
+    );
     assert!(e.contains("lambda") && e.contains("> 0"), "{e}");
-    let e = build_err("[policy]\ntype = \"linucb_qg\"\nalpha = 1.0\nw = -0.5\n", &c);
+    let e = build_err(
+        "[policy]\ntype = \"linucb_qg\"\nalpha = 1.0\nw = -0.5\n",
+        &c,
+    );
     assert!(e.contains("`w`") && e.contains("-0.5"), "{e}");
-    let e = build_err("[policy]\ntype = \"linucb_exp_decay\"\nalpha = 1.0\nc = -2\n", &c);
+    let e = build_err(
+        "[policy]\ntype = \"linucb_exp_decay\"\nalpha = 1.0\nc = -2\n",
+        &c,
+    );
     assert!(e.contains("`c`"), "{e}");
-    let e = build_err("[policy]\ntype = \"linucb\"\nalpha = 1.0\nalhpa = 2.0\n", &c);
+    let e = build_err(
+        "[policy]\ntype = \"linucb\"\nalpha = 1.0\nalhpa = 2.0\n",
+        &c,
+    );
     assert!(e.contains("alhpa"), "{e}");
-    let e = build_err("[policy]\ntype = \"linucb\"\nalpha = 1.0\npretrain = true\n", &c);
-    assert!(e.contains("pretrain") && e.contains("no pretraining data"), "{e}");
-    let e = build_err("[policy]\ntype = \"linucb\"\nalpha = 1.0\n", &BuildContext::new(".", 0));
+    let e = build_err(
+        "[policy]\ntype = \"linucb\"\nalpha = 1.0\npretrain = true\n",
+        &c,
+    );
+    assert!(
+        e.contains("pretrain") && e.contains("no pretraining data"),
+        "{e}"
+    );
+    let e = build_err(
+        "[policy]\ntype = \"linucb\"\nalpha = 1.0\n",
+        &BuildContext::new(".", 0),
+    );
     assert!(e.contains("action space"), "{e}");
 }
 

@@ -15,17 +15,15 @@ const DIM: usize = 4;
 const ARMS: usize = 3;
 
 fn observations(max: usize) -> impl Strategy<Value = Vec<LabelledObservation>> {
-    proptest::collection::vec((context(DIM, 1.0), 0..ARMS, 0.0f64..=1.0), 0..=max).prop_map(
-        |v| {
-            v.into_iter()
-                .map(|(context, arm, reward)| LabelledObservation {
-                    context,
-                    arm: ArmId(arm),
-                    reward,
-                })
-                .collect()
-        },
-    )
+    proptest::collection::vec((context(DIM, 1.0), 0..ARMS, 0.0f64..=1.0), 0..=max).prop_map(|v| {
+        v.into_iter()
+            .map(|(context, arm, reward)| LabelledObservation {
+                context,
+                arm: ArmId(arm),
+                reward,
+            })
+            .collect()
+    })
 }
 
 fn representation() -> impl Strategy<Value = RepresentationChoice> {

@@ -11,9 +11,8 @@ use hil_core::{
     QueryHistory, QueryKind, Result, Timestep, WorkloadForecast, WorkloadModel,
 };
 use hil_policies::{
-    AlwaysQuery, AlwaysQueryParams, EstimatorOptions, LinUcb, LinUcbExpDecay,
-    LinUcbExpDecayParams, LinUcbParams, LinUcbQg, LinUcbQgParams, LinearArms, Representation,
-    RepresentationChoice,
+    AlwaysQuery, AlwaysQueryParams, EstimatorOptions, LinUcb, LinUcbExpDecay, LinUcbExpDecayParams,
+    LinUcbParams, LinUcbQg, LinUcbQgParams, LinearArms, Representation, RepresentationChoice,
 };
 use serde_json::json;
 

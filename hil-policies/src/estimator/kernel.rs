@@ -130,8 +130,8 @@ impl KernelArm {
             let off = row_packed_offset(i);
             beta[i] /= self.l[off + i];
             let bi = beta[i];
-            for j in 0..i {
-                beta[j] -= self.l[off + j] * bi;
+            for (bj, lij) in beta[..i].iter_mut().zip(&self.l[off..off + i]) {
+                *bj -= lij * bi;
             }
         }
         let mut theta = vec![0.0; dim];

@@ -144,7 +144,12 @@ fn forward_solve_col_packed_avx2(l: &[f64], w: &mut [f64]) {
 /// replaces L by the Cholesky factor of LLᵀ + wwᵀ (`w` is consumed), and
 /// solves the new L·c = v into `c` (`v` is consumed) column by column while
 /// each column is in cache.
-pub(crate) fn rank_one_update_col_packed(l: &mut [f64], w: &mut [f64], v: &mut [f64], c: &mut [f64]) {
+pub(crate) fn rank_one_update_col_packed(
+    l: &mut [f64],
+    w: &mut [f64],
+    v: &mut [f64],
+    c: &mut [f64],
+) {
     #[cfg(target_arch = "x86_64")]
     if has_avx2_fma() {
         // SAFETY: the CPU supports the features the variant is compiled for.
@@ -168,7 +173,10 @@ macro_rules! rank_one_body {
             col[0] = r;
             let cj = v[j] / r;
             c[j] = cj;
-            let tail = col[1..].iter_mut().zip(&mut w[j + 1..]).zip(&mut v[j + 1..]);
+            let tail = col[1..]
+                .iter_mut()
+                .zip(&mut w[j + 1..])
+                .zip(&mut v[j + 1..]);
             for ((lij, wi), vi) in tail {
                 let nl = (*lij + sn * *wi) * inv_cs;
                 *wi = cs * *wi - sn * nl;
@@ -220,7 +228,11 @@ mod tests {
         let row = [2.0, 1.0, 3.0, -1.0, 0.5, 4.0];
         let col = [2.0, 1.0, -1.0, 3.0, 0.5, 4.0];
         let z = [1.0, -2.0, 0.25];
-        let k = [2.0 * z[0], z[0] + 3.0 * z[1], -z[0] + 0.5 * z[1] + 4.0 * z[2]];
+        let k = [
+            2.0 * z[0],
+            z[0] + 3.0 * z[1],
+            -z[0] + 0.5 * z[1] + 4.0 * z[2],
+        ];
         let mut a = k;
         forward_solve_row_packed(&row, &mut a);
         let mut b = k;

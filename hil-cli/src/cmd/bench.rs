@@ -230,6 +230,10 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
     };
     policy.seed(a.seed);
 
+    // Read bandwidth is sampled between steps, so that the floor sees the
+    // same machine load as the steps do (this machine is shared).
+    let bw_buf: Vec<f64> = (0..BW_LEN).map(|i| (i % 7) as f64).collect();
+    let mut bw_samples = Vec::new();
     let model = PerQuery;
     let mut history = QueryHistory::new();
     let warmup = 3.min(a.steps);
@@ -237,6 +241,9 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
     let mut decide_us = Vec::with_capacity(a.steps);
     let mut queries = 0usize;
     for s in 0..(a.steps + warmup) {
+        if s % 20 == 0 {
+            bw_samples.push(read_bandwidth(&bw_buf));
+        }
         let x = rng.context(a.dim);
         let t = s as Timestep + 1;
         let input = DecisionInput {
@@ -283,7 +290,8 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
     let per_step_us = median(&mut step_us.clone());
     let decide_median = median(&mut decide_us);
     let bytes_per_step = bytes_per_score + bytes_per_update;
-    let bw = read_bandwidth();
+    bw_samples.push(read_bandwidth(&bw_buf));
+    let bw = median(&mut bw_samples);
     let floor_us = bytes_per_step as f64 / bw * 1e6;
     let load = std::fs::read_to_string("/proc/loadavg")
         .ok()
@@ -311,6 +319,8 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         "read_bandwidth_gb_s": bw / 1e9,
         "bandwidth_floor_us": floor_us,
         "ratio_to_floor": per_step_us / floor_us,
+        "p10_ratio_to_floor": pct(0.1) / floor_us,
+        "bandwidth_samples": bw_samples.len(),
         "load_average_1m": load,
         "data": "synthetic",
     });
@@ -350,15 +360,16 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// Single-thread read bandwidth in bytes/s: the best of several sums over a
-/// 256 MiB buffer (far beyond any cache), measured in this run so that the
-/// floor reflects the machine's current load.
-fn read_bandwidth() -> f64 {
-    let n = 32 << 20; // 32 Mi f64 = 256 MiB
-    let buf: Vec<f64> = (0..n).map(|i| (i % 7) as f64).collect();
+/// Length of the bandwidth probe: 256 MiB of f64, far beyond any
+/// last-level cache.
+const BW_LEN: usize = 32 << 20;
+
+/// Single-thread read bandwidth in bytes/s: the faster of two sums over
+/// `buf` (the first may still be warming the TLB).
+fn read_bandwidth(buf: &[f64]) -> f64 {
     let mut best = f64::INFINITY;
     let mut sink = 0.0;
-    for _ in 0..5 {
+    for _ in 0..2 {
         let t = Instant::now();
         let mut acc = [0.0f64; 8];
         for c in buf.chunks_exact(8) {
@@ -370,5 +381,5 @@ fn read_bandwidth() -> f64 {
         best = best.min(t.elapsed().as_secs_f64());
     }
     std::hint::black_box(sink);
-    (n * std::mem::size_of::<f64>()) as f64 / best
+    std::mem::size_of_val(buf) as f64 / best
 }

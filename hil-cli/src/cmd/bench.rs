@@ -162,15 +162,11 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         1.0 / (1.0 + (-4.0 * s).exp())
     };
     let mut data = Vec::with_capacity(a.pretrain * a.arms);
-    let shared: Vec<Context> = if a.shared_contexts {
-        (0..a.pretrain).map(|_| rng.context(a.dim)).collect()
-    } else {
-        Vec::new()
-    };
-    for i in 0..a.pretrain {
+    for _ in 0..a.pretrain {
+        let shared = rng.context(a.dim);
         for arm in 0..a.arms {
             let x = if a.shared_contexts {
-                shared[i].clone()
+                shared.clone()
             } else {
                 rng.context(a.dim)
             };
@@ -211,6 +207,11 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
     };
     let bytes_per_score = arms.bytes_per_score();
     let bytes_per_update = arms.bytes_per_update(ArmId(0))?;
+    // A dense update rewrites the factor it read; a kernel update appends O(n).
+    let bytes_written = match arms.representation(ArmId(0))? {
+        Representation::Dense => bytes_per_update,
+        Representation::Kernel => 0,
+    };
 
     let kind = QueryKind::default();
     let mut policy: Box<dyn Policy> = match a.policy {
@@ -320,6 +321,9 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         "bandwidth_floor_us": floor_us,
         "ratio_to_floor": per_step_us / floor_us,
         "p10_ratio_to_floor": pct(0.1) / floor_us,
+        "bytes_written_per_step": bytes_written,
+        "floor_with_writes_us": (bytes_per_step + bytes_written) as f64 / bw * 1e6,
+        "ratio_to_floor_with_writes": per_step_us * bw / 1e6 / (bytes_per_step + bytes_written) as f64,
         "bandwidth_samples": bw_samples.len(),
         "load_average_1m": load,
         "data": "synthetic",

@@ -24,6 +24,8 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Inspect plugin libraries and check their types for conformance.
     Plugins(cmd::plugins::PluginsArgs),
+    /// Benchmark components (e.g. `hil bench policy --policy linucb_qg`).
+    Bench(cmd::bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Plugins(args) => cmd::plugins::run(args),
+        Command::Bench(args) => cmd::bench::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

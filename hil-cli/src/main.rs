@@ -28,6 +28,10 @@ enum Command {
     Reproduce(cmd::reproduce::ReproduceArgs),
     /// Workload study data and models: generate, select, fit, rollout, bundle.
     Workload(cmd::workload::WorkloadArgs),
+    /// Inspect plugin libraries and check their types for conformance.
+    Plugins(cmd::plugins::PluginsArgs),
+    /// Benchmark components (e.g. `hil bench policy --policy linucb_qg`).
+    Bench(cmd::bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -37,12 +41,15 @@ fn main() -> ExitCode {
     hil_workload::link();
     hil_envs::link();
     hil_kinova_mujoco::link();
+    hil_channels::link();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Data(args) => cmd::data::run(args),
         Command::Reproduce(args) => cmd::reproduce::run(args),
         Command::Workload(args) => cmd::workload::run(args),
+        Command::Plugins(args) => cmd::plugins::run(args),
+        Command::Bench(args) => cmd::bench::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

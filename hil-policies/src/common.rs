@@ -104,16 +104,12 @@ pub(crate) fn build_estimator(
     pretrain: bool,
     options: EstimatorOptions,
 ) -> Result<LinearArms> {
-    let n_arms = ctx
-        .action_space
-        .as_ref()
-        .map(|a| a.len())
-        .ok_or_else(|| {
-            HilError::state(
-                "policy config",
-                "the action space is unknown (build the environment first)",
-            )
-        })?;
+    let n_arms = ctx.action_space.as_ref().map(|a| a.len()).ok_or_else(|| {
+        HilError::state(
+            "policy config",
+            "the action space is unknown (build the environment first)",
+        )
+    })?;
     let dim = ctx.context_dim.ok_or_else(|| {
         HilError::state(
             "policy config",

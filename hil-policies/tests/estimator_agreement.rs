@@ -9,7 +9,12 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 fn ctx(rng: &mut ChaCha8Rng, d: usize) -> Context {
-    Context::new((0..d).map(|_| rng.random_range(-1.0..1.0)).collect::<Vec<_>>()).unwrap()
+    Context::new(
+        (0..d)
+            .map(|_| rng.random_range(-1.0..1.0))
+            .collect::<Vec<_>>(),
+    )
+    .unwrap()
 }
 
 fn close(a: f64, b: f64, what: &str) {
@@ -74,8 +79,14 @@ fn representations_agree_with_direct_inverse() {
     for e in &mut ests {
         e.pretrain(&batch).unwrap();
     }
-    assert_eq!(ests[2].representation(ArmId(0)).unwrap(), Representation::Dense);
-    assert_eq!(ests[2].representation(ArmId(1)).unwrap(), Representation::Kernel);
+    assert_eq!(
+        ests[2].representation(ArmId(0)).unwrap(),
+        Representation::Dense
+    );
+    assert_eq!(
+        ests[2].representation(ArmId(1)).unwrap(),
+        Representation::Kernel
+    );
     check_all(&mut ests, &naive, &ctx(&mut rng, d), n_arms);
 
     // Online updates, scored first (cached path) or not, crossing over on arm 1.
@@ -94,8 +105,14 @@ fn representations_agree_with_direct_inverse() {
         naive.push(arm, &x, r);
         check_all(&mut ests, &naive, &ctx(&mut rng, d), n_arms);
     }
-    assert_eq!(ests[2].representation(ArmId(1)).unwrap(), Representation::Dense);
-    assert_eq!(ests[0].representation(ArmId(1)).unwrap(), Representation::Kernel);
+    assert_eq!(
+        ests[2].representation(ArmId(1)).unwrap(),
+        Representation::Dense
+    );
+    assert_eq!(
+        ests[0].representation(ArmId(1)).unwrap(),
+        Representation::Kernel
+    );
 }
 
 #[test]
@@ -123,7 +140,10 @@ fn duplicate_and_collinear_contexts_stay_finite() {
         // Along the observed direction the estimate is the mean-ish fit.
         let want = naive.estimate(0, &probe).unwrap();
         let got = e.scores(&probe).unwrap()[0];
-        assert!((got.estimate - want.estimate).abs() < 1e-6, "{r:?}: {got:?} vs {want:?}");
+        assert!(
+            (got.estimate - want.estimate).abs() < 1e-6,
+            "{r:?}: {got:?} vs {want:?}"
+        );
     }
 }
 
@@ -131,7 +151,8 @@ fn duplicate_and_collinear_contexts_stay_finite() {
 fn checkpoint_round_trip_is_bit_exact() {
     let (d, n_arms) = (9, 2);
     let mut rng = ChaCha8Rng::seed_from_u64(5);
-    let mut e = LinearArms::with_options(n_arms, d, 0.3, options(RepresentationChoice::Auto)).unwrap();
+    let mut e =
+        LinearArms::with_options(n_arms, d, 0.3, options(RepresentationChoice::Auto)).unwrap();
     let batch: Vec<_> = (0..6)
         .map(|i| LabelledObservation {
             context: ctx(&mut rng, d),
@@ -175,7 +196,10 @@ fn bad_input_is_an_error_naming_the_value() {
 
     let mut e = LinearArms::new(2, 3, 1.0).unwrap();
     let x = Context::new(vec![1.0, 2.0, 3.0]).unwrap();
-    let msg = e.scores(&[1.0, f64::INFINITY, 0.0]).unwrap_err().to_string();
+    let msg = e
+        .scores(&[1.0, f64::INFINITY, 0.0])
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("context[1]") && msg.contains("inf"), "{msg}");
     let msg = e.scores(&[1.0, 2.0]).unwrap_err().to_string();
     assert!(msg.contains("expected 3, got 2"), "{msg}");
@@ -186,12 +210,23 @@ fn bad_input_is_an_error_naming_the_value() {
     let wrong = Context::new(vec![1.0; 4]).unwrap();
     let msg = e
         .pretrain(&[
-            LabelledObservation { context: x.clone(), arm: ArmId(0), reward: 1.0 },
-            LabelledObservation { context: wrong, arm: ArmId(0), reward: 1.0 },
+            LabelledObservation {
+                context: x.clone(),
+                arm: ArmId(0),
+                reward: 1.0,
+            },
+            LabelledObservation {
+                context: wrong,
+                arm: ArmId(0),
+                reward: 1.0,
+            },
         ])
         .unwrap_err()
         .to_string();
-    assert!(msg.contains("record #1") && msg.contains("expected 3, got 4"), "{msg}");
+    assert!(
+        msg.contains("record #1") && msg.contains("expected 3, got 4"),
+        "{msg}"
+    );
     // Nothing was applied from the rejected batch.
     assert_eq!(e.n_observations(ArmId(0)).unwrap(), 0);
 }

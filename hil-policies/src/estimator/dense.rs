@@ -68,32 +68,12 @@ impl DenseArm {
     /// Adds one observation: L ← chol(LLᵀ + xxᵀ), b ← b + r·x, c ← L⁻¹b,
     /// in one pass over L.
     pub(crate) fn update(&mut self, x: &[f64], reward: f64) {
-        let d = self.dim;
         for (bi, xi) in self.b.iter_mut().zip(x) {
             *bi += reward * xi;
         }
         let mut w = x.to_vec();
         let mut v = self.b.clone();
-        let mut off = 0;
-        for j in 0..d {
-            let col = &mut self.l[off..off + (d - j)];
-            let (ljj, wj) = (col[0], w[j]);
-            let r = (ljj * ljj + wj * wj).sqrt();
-            // Rotation taking (ljj, wj) to (r, 0); r ≥ ljj > 0.
-            let (cs, sn) = (r / ljj, wj / ljj);
-            let inv_cs = ljj / r;
-            col[0] = r;
-            let cj = v[j] / r;
-            self.c[j] = cj;
-            let tail = col[1..].iter_mut().zip(&mut w[j + 1..]).zip(&mut v[j + 1..]);
-            for ((lij, wi), vi) in tail {
-                let nl = (*lij + sn * *wi) * inv_cs;
-                *wi = cs * *wi - sn * nl;
-                *vi -= cj * nl;
-                *lij = nl;
-            }
-            off += d - j;
-        }
+        super::linalg::rank_one_update_col_packed(&mut self.l, &mut w, &mut v, &mut self.c);
         self.n += 1;
     }
 

@@ -86,7 +86,9 @@ impl KernelArm {
         self.finish_score(xx, lambda, z)
     }
 
-    /// Like [`Self::score_from_products`], computing k directly from the store.
+    /// Like [`Self::score_from_products`], computing the products from the
+    /// store (all rows, so that the numbers are bit-identical to the ones a
+    /// scoring pass produces: checkpoint replay depends on it).
     pub(crate) fn score_direct(
         &self,
         store: &RowStore,
@@ -94,9 +96,9 @@ impl KernelArm {
         lambda: f64,
         z: &mut Vec<f64>,
     ) -> (f64, f64) {
-        z.clear();
-        z.extend(self.rows.iter().map(|&r| dot(store.row(r as usize), x)));
-        self.finish_score(dot(x, x), lambda, z)
+        let mut g = Vec::new();
+        store.products(x, &mut g);
+        self.score_from_products(&g, dot(x, x), lambda, z)
     }
 
     fn finish_score(&self, xx: f64, lambda: f64, z: &mut [f64]) -> (f64, f64) {
@@ -128,8 +130,8 @@ impl KernelArm {
             let off = row_packed_offset(i);
             beta[i] /= self.l[off + i];
             let bi = beta[i];
-            for j in 0..i {
-                beta[j] -= self.l[off + j] * bi;
+            for (bj, lij) in beta[..i].iter_mut().zip(&self.l[off..off + i]) {
+                *bj -= lij * bi;
             }
         }
         let mut theta = vec![0.0; dim];

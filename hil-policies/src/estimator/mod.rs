@@ -237,7 +237,9 @@ impl LinearArms {
     pub fn pretrain(&mut self, data: &[LabelledObservation]) -> Result<()> {
         for (i, obs) in data.iter().enumerate() {
             self.check_observation(&obs.context, obs.arm, obs.reward)
-                .map_err(|e| HilError::invalid_input(format!("pretraining record #{i}"), e.to_string()))?;
+                .map_err(|e| {
+                    HilError::invalid_input(format!("pretraining record #{i}"), e.to_string())
+                })?;
         }
         if data.is_empty() {
             return Ok(());

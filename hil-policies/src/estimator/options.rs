@@ -34,10 +34,12 @@ pub enum RepresentationChoice {
 ///
 /// Per score, an arm in kernel form streams n·d + n²/2 numbers (its rows and
 /// its factor) and one in dense form d²/2, so the byte counts cross at
-/// n ≈ (√2 − 1)·d ≈ 0.41·d. Measured with `hil bench policy` at d = 2048
-/// (single arm, private contexts), kernel and dense per-step times cross
-/// near the same point; see the crate README for the numbers.
-pub const DEFAULT_CROSSOVER: f64 = 0.41;
+/// n ≈ (√2 − 1)·d ≈ 0.41·d. The kernel pass does more arithmetic per byte
+/// (products, then a triangular solve), and measured with
+/// `hil bench policy --arms 1 --dim 2048 --representation kernel|dense`
+/// the per-step times cross at n ≈ 1000 ≈ 0.49·d (median 1356 vs 1385 µs
+/// at n = 1000; kernel faster at n = 800, dense faster at n = 1200).
+pub const DEFAULT_CROSSOVER: f64 = 0.48;
 
 /// Estimator options beyond λ.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,8 +1,8 @@
 //! Exact serialisation of a ChaCha8 generator: seed, stream and word position.
 
 use hil_core::{HilError, Result};
-use rand_chacha::ChaCha8Rng;
 use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 

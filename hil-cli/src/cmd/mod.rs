@@ -1,8 +1,8 @@
 //! One module per subcommand.
 
-pub mod data;
-pub mod reproduce;
-pub mod plugins;
 pub mod bench;
+pub mod data;
+pub mod plugins;
+pub mod reproduce;
 pub mod run;
 pub mod workload;

@@ -108,7 +108,10 @@ pub fn solve_psd(a: &[f64], k: usize, idx: &[usize], rhs: &[f64]) -> Vec<f64> {
         // pick the largest remaining pivot
         let (p, piv) = (j..m)
             .map(|i| (i, l[i * m + i]))
-            .fold((j, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc });
+            .fold(
+                (j, f64::NEG_INFINITY),
+                |acc, x| if x.1 > acc.1 { x } else { acc },
+            );
         if piv <= tol {
             break;
         }
@@ -197,7 +200,8 @@ impl<'a> BoxLsq<'a> {
         let k = self.gram.k;
         let mut s = 0.0;
         for i in 0..k {
-            let gw: f64 = (0..k).map(|j| self.gram.g[i * k + j] * w[j]).sum::<f64>() + self.ridge[i] * w[i];
+            let gw: f64 =
+                (0..k).map(|j| self.gram.g[i * k + j] * w[j]).sum::<f64>() + self.ridge[i] * w[i];
             s += 0.5 * w[i] * gw - self.gram.b[i] * w[i];
         }
         s
@@ -208,11 +212,21 @@ impl<'a> BoxLsq<'a> {
     pub fn solve(&self, start: Option<&[f64]>) -> Result<Vec<f64>> {
         let k = self.gram.k;
         if self.ridge.len() != k || self.lower.len() != k || self.upper.len() != k {
-            return Err(HilError::invalid_input("least-squares problem", "bounds or penalties have the wrong length"));
+            return Err(HilError::invalid_input(
+                "least-squares problem",
+                "bounds or penalties have the wrong length",
+            ));
         }
         for i in 0..k {
-            if self.lower[i] > self.upper[i] || self.ridge[i] < 0.0 || self.lower[i].is_nan() || self.upper[i].is_nan() {
-                return Err(HilError::invalid_input("least-squares problem", format!("coefficient {i} has empty bounds or a negative penalty")));
+            if self.lower[i] > self.upper[i]
+                || self.ridge[i] < 0.0
+                || self.lower[i].is_nan()
+                || self.upper[i].is_nan()
+            {
+                return Err(HilError::invalid_input(
+                    "least-squares problem",
+                    format!("coefficient {i} has empty bounds or a negative penalty"),
+                ));
             }
         }
         let mut h = self.gram.g.clone();
@@ -221,7 +235,11 @@ impl<'a> BoxLsq<'a> {
         }
         let b = &self.gram.b;
         let mut x: Vec<f64> = (0..k)
-            .map(|i| start.map_or(0.0, |s| s[i]).clamp(self.lower[i], self.upper[i]))
+            .map(|i| {
+                start
+                    .map_or(0.0, |s| s[i])
+                    .clamp(self.lower[i], self.upper[i])
+            })
             .collect();
         // Coefficients of all-zero columns do not affect the objective:
         // they stay at their (projected) start value.
@@ -231,7 +249,9 @@ impl<'a> BoxLsq<'a> {
             .collect();
         let scale = b.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         let tol = 1e-10 * scale;
-        let grad = |x: &[f64], i: usize| -> f64 { (0..k).map(|j| h[i * k + j] * x[j]).sum::<f64>() - b[i] };
+        let grad = |x: &[f64], i: usize| -> f64 {
+            (0..k).map(|j| h[i * k + j] * x[j]).sum::<f64>() - b[i]
+        };
         let max_iter = 20 * k + 200;
         for _ in 0..max_iter {
             let idx: Vec<usize> = (0..k).filter(|&i| free[i]).collect();
@@ -313,7 +333,10 @@ mod tests {
         let rows: Vec<_> = (0..10)
             .map(|i| {
                 let a = i as f64;
-                (vec![1.0, a, (a * 0.7).sin()], 2.0 - 0.5 * a + 3.0 * (a * 0.7).sin())
+                (
+                    vec![1.0, a, (a * 0.7).sin()],
+                    2.0 - 0.5 * a + 3.0 * (a * 0.7).sin(),
+                )
             })
             .collect();
         let g = gram_of(&rows);
@@ -335,7 +358,10 @@ mod tests {
         let g = gram_of(&rows);
         let p = BoxLsq::plain(&g);
         let w = p.solve(None).unwrap();
-        let resid: f64 = rows.iter().map(|(x, y)| (x.iter().zip(&w).map(|(a, b)| a * b).sum::<f64>() - y).powi(2)).sum();
+        let resid: f64 = rows
+            .iter()
+            .map(|(x, y)| (x.iter().zip(&w).map(|(a, b)| a * b).sum::<f64>() - y).powi(2))
+            .sum();
         assert!(resid < 1e-18, "{w:?} {resid}");
     }
 
@@ -344,7 +370,10 @@ mod tests {
         let rows: Vec<_> = (0..12)
             .map(|i| {
                 let a = i as f64;
-                (vec![1.0, a, (a * 1.3).cos()], 1.0 - 0.3 * a + 0.2 * (a * 1.3).cos())
+                (
+                    vec![1.0, a, (a * 1.3).cos()],
+                    1.0 - 0.3 * a + 0.2 * (a * 1.3).cos(),
+                )
             })
             .collect();
         let g = gram_of(&rows);
@@ -354,7 +383,9 @@ mod tests {
         assert!(w[1] >= 0.0 && w[2] >= 0.0);
         assert_eq!(w[1], 0.0, "{w:?}");
         // KKT: gradient zero on free coordinates, ≥ 0 at the lower bound
-        let gr: Vec<f64> = (0..3).map(|i| (0..3).map(|j| g.g[i * 3 + j] * w[j]).sum::<f64>() - g.b[i]).collect();
+        let gr: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|j| g.g[i * 3 + j] * w[j]).sum::<f64>() - g.b[i])
+            .collect();
         assert!(gr[0].abs() < 1e-9 && gr[1] >= -1e-9, "{gr:?}");
     }
 }

@@ -17,9 +17,17 @@ fn bundled_config_builds_every_bundled_model() {
         assert_eq!(m.name(), name);
         assert!(m.predict(0.5, &QueryHistory::new(), 0).unwrap().is_finite());
     }
-    let e = parse(r#"{"type": "bundled", "name": "f9"}"#).unwrap().build(&ctx).err().unwrap().to_string();
+    let e = parse(r#"{"type": "bundled", "name": "f9"}"#)
+        .unwrap()
+        .build(&ctx)
+        .err()
+        .unwrap()
+        .to_string();
     assert!(e.contains("f9") && e.contains("f1_sim"), "{e}");
-    let e = parse(r#"{"type": "bundled", "name": "f1_sim", "nme": 1}"#).err().unwrap().to_string();
+    let e = parse(r#"{"type": "bundled", "name": "f1_sim", "nme": 1}"#)
+        .err()
+        .unwrap()
+        .to_string();
     assert!(e.contains("nme"), "{e}");
 }
 
@@ -32,7 +40,11 @@ fn model_file_config_resolves_against_the_config_dir() {
     let cfg = parse(r#"{"type": "model_file", "path": "m/x.json"}"#).unwrap();
     let m = cfg.build(&BuildContext::new(&dir, 0)).unwrap();
     assert_eq!(m.name(), "f12_real");
-    let e = cfg.build(&BuildContext::new("/nonexistent", 0)).err().unwrap().to_string();
+    let e = cfg
+        .build(&BuildContext::new("/nonexistent", 0))
+        .err()
+        .unwrap()
+        .to_string();
     assert!(e.contains("/nonexistent/m/x.json"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -25,7 +25,11 @@ fn tiny() -> Study {
         "p3,occupational_therapist,c1,60,easy,mcq,none,1,2,2,2,2,2,",
         "p3,occupational_therapist,c1,120,easy,mcq,none,1,2,2,2,2,2,",
     ];
-    Study::parse(&format!("{HEADER}\n{}\n", rows.join("\n")), Path::new("tiny.csv")).unwrap()
+    Study::parse(
+        &format!("{HEADER}\n{}\n", rows.join("\n")),
+        Path::new("tiny.csv"),
+    )
+    .unwrap()
 }
 
 #[test]
@@ -41,7 +45,11 @@ fn survey_time_rule_and_wl0() {
     let d12 = Dataset::build(&s, DatasetId::D12).unwrap();
     let t_of = |pid: &str| -> Vec<u64> {
         let p = d12.participants.iter().position(|x| x == pid).unwrap();
-        d12.pairs.iter().filter(|q| q.participant == p).map(|q| q.t).collect()
+        d12.pairs
+            .iter()
+            .filter(|q| q.participant == p)
+            .map(|q| q.t)
+            .collect()
     };
     assert_eq!(t_of("p1"), vec![6, 12]); // 120 + 5 s = 12.5 -> 12
     assert_eq!(t_of("p2"), vec![6, 15]); // 120 + 30 s logged
@@ -56,31 +64,54 @@ fn missing_baseline_is_an_error_naming_the_row() {
     let text = format!("{HEADER}\np9,no_limitation,c1,60,easy,mcq,none,1,1,1,1,1,1,\n");
     let s = Study::parse(&text, Path::new("nb.csv")).unwrap();
     let e = Dataset::build(&s, DatasetId::D1).unwrap_err().to_string();
-    assert!(e.contains("nb.csv:2") && e.contains("p9") && e.contains("WL_0"), "{e}");
-    let e = Dataset::build(&tiny(), DatasetId::D1).map(|_| ()).and_then(|_| Dataset::build(&s, DatasetId::D2).map(|_| ()));
+    assert!(
+        e.contains("nb.csv:2") && e.contains("p9") && e.contains("WL_0"),
+        "{e}"
+    );
+    let e = Dataset::build(&tiny(), DatasetId::D1)
+        .map(|_| ())
+        .and_then(|_| Dataset::build(&s, DatasetId::D2).map(|_| ()));
     assert!(e.unwrap_err().to_string().contains("no query rows"));
 }
 
 #[test]
 fn default_synthetic_study_matches_the_papers_design_figures() {
-    let study = SynthConfig::default().generate(hil_workload::bundle::STUDY_SEED).unwrap();
+    let study = SynthConfig::default()
+        .generate(hil_workload::bundle::STUDY_SEED)
+        .unwrap();
     let s = StudySummary::of(&study).unwrap();
     let (_, n1, m1, sd1, _) = s.datasets[0];
     let (_, n2, m2, sd2, _) = s.datasets[1];
     assert_eq!(n1, 4272);
     assert_eq!(n2, 705);
-    assert!((m1 - 0.36).abs() < 0.02 && (sd1 - 0.29).abs() < 0.02, "{m1} {sd1}");
-    assert!((m2 - 0.40).abs() < 0.02 && (sd2 - 0.28).abs() < 0.03, "{m2} {sd2}");
+    assert!(
+        (m1 - 0.36).abs() < 0.02 && (sd1 - 0.29).abs() < 0.02,
+        "{m1} {sd1}"
+    );
+    assert!(
+        (m2 - 0.40).abs() < 0.02 && (sd2 - 0.28).abs() < 0.03,
+        "{m2} {sd2}"
+    );
     assert!(s.d1_less_than_d2.unwrap().p_value < 0.05);
     // the bundled CSV is this study
-    let bundled = Study::load(concat!(env!("CARGO_MANIFEST_DIR"), "/data/synthetic_study.csv")).unwrap();
-    assert!(bundled.to_csv() == study.to_csv(), "data/synthetic_study.csv is stale: run `hil workload bundle`");
+    let bundled = Study::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/synthetic_study.csv"
+    ))
+    .unwrap();
+    assert!(
+        bundled.to_csv() == study.to_csv(),
+        "data/synthetic_study.csv is stale: run `hil workload bundle`"
+    );
 }
 
 #[test]
 fn selection_on_a_small_study() {
     let study = SynthConfig::small(10, 4).generate(5).unwrap();
-    let sets: Vec<Dataset> = DatasetId::ALL.iter().map(|&id| Dataset::build(&study, id).unwrap()).collect();
+    let sets: Vec<Dataset> = DatasetId::ALL
+        .iter()
+        .map(|&id| Dataset::build(&study, id).unwrap())
+        .collect();
     let refs: Vec<&Dataset> = sets.iter().collect();
     let opts = SelectOptions {
         histories: vec![1, 5],
@@ -106,12 +137,24 @@ fn selection_on_a_small_study() {
             let (m, s) = mean_std(&r.fold_mse);
             assert!((m - r.mean).abs() < 1e-12 && (s - r.std).abs() < 1e-12);
             if matches!(r.candidate, Candidate::Granger { variant, .. } if variant.is_ridge()) {
-                assert!(r.fold_lambda.iter().all(|l| l.is_some_and(|l| opts.lambdas.contains(&l))));
+                assert!(
+                    r.fold_lambda
+                        .iter()
+                        .all(|l| l.is_some_and(|l| opts.lambdas.contains(&l)))
+                );
             }
         }
     }
     // deterministic given the seed, and independent of the thread count
-    let again = cross_validate(&refs, &cands, &SelectOptions { threads: 1, ..opts.clone() }).unwrap();
+    let again = cross_validate(
+        &refs,
+        &cands,
+        &SelectOptions {
+            threads: 1,
+            ..opts.clone()
+        },
+    )
+    .unwrap();
     assert_eq!(again.rows, table.rows);
     let md = table.to_markdown();
     assert!(md.contains("| Granger-RN | 5 |") && md.contains("**"));

@@ -32,7 +32,11 @@ fn fitted(d: &Dataset) -> Vec<FittedModel> {
         .into_iter()
         .map(|c| {
             let (spec, _) = fit_on_all(d, c, &opts).unwrap();
-            FittedModel::new(format!("{}_{:?}", c.label(), c.history()), spec, Provenance::default())
+            FittedModel::new(
+                format!("{}_{:?}", c.label(), c.history()),
+                spec,
+                Provenance::default(),
+            )
         })
         .collect()
 }
@@ -72,15 +76,26 @@ fn model_files_from_other_versions_or_with_bad_fields_are_clear_errors() {
     let m = hil_workload::bundled::load_fitted("f1_sim").unwrap();
     let json = m.to_json();
     let v2 = json.replace("\"format_version\": 1", "\"format_version\": 2");
-    let e = FittedModel::from_json(&v2, "m.json".as_ref()).unwrap_err().to_string();
-    assert!(e.contains("m.json:3") && e.contains("format_version") && e.contains("version 2"), "{e}");
+    let e = FittedModel::from_json(&v2, "m.json".as_ref())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("m.json:3") && e.contains("format_version") && e.contains("version 2"),
+        "{e}"
+    );
     let wrong = json.replace("\"history\": 10", "\"history\": 9");
-    let e = FittedModel::from_json(&wrong, "m.json".as_ref()).unwrap_err().to_string();
+    let e = FittedModel::from_json(&wrong, "m.json".as_ref())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("m.json") && e.contains("history"), "{e}");
     let extra = json.replace("\"gamma\"", "\"gama\": 1, \"gamma\"");
-    let e = FittedModel::from_json(&extra, "m.json".as_ref()).unwrap_err().to_string();
+    let e = FittedModel::from_json(&extra, "m.json".as_ref())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("gama"), "{e}");
-    let e = FittedModel::from_json("{}", "m.json".as_ref()).unwrap_err().to_string();
+    let e = FittedModel::from_json("{}", "m.json".as_ref())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("format"), "{e}");
     // bounds of the simulation variant are enforced on load
     let out = json.replacen("0.05,", "-0.5,", 1);
@@ -94,7 +109,9 @@ fn sparse_design_path_matches_model_predictions() {
         if let ModelSpec::Granger(g) = &m.spec {
             let w = g.coefficients();
             for p in &d.pairs {
-                let fast = SparseRow::of_pair(p, g.history).dot_prefix(&w).clamp(0.0, 1.0);
+                let fast = SparseRow::of_pair(p, g.history)
+                    .dot_prefix(&w)
+                    .clamp(0.0, 1.0);
                 let slow = g.predict(p.wl0, &p.history, p.t).unwrap();
                 assert!((fast - slow).abs() < 1e-12, "{}: {fast} vs {slow}", m.name);
             }
@@ -109,7 +126,11 @@ fn constrained_fits_respect_their_bounds() {
         if let ModelSpec::Granger(g) = &m.spec {
             let (lo, hi) = g.variant.bounds(g.history);
             for (i, c) in g.coefficients().iter().enumerate() {
-                assert!(*c >= lo[i] && *c <= hi[i], "{}: coefficient {i} = {c}", m.name);
+                assert!(
+                    *c >= lo[i] && *c <= hi[i],
+                    "{}: coefficient {i} = {c}",
+                    m.name
+                );
             }
         }
     }
@@ -117,7 +138,10 @@ fn constrained_fits_respect_their_bounds() {
 
 fn monotone_models() -> Vec<FittedModel> {
     let d = small_d12();
-    let mut v: Vec<FittedModel> = fitted(&d).into_iter().filter(|m| m.spec.is_monotone()).collect();
+    let mut v: Vec<FittedModel> = fitted(&d)
+        .into_iter()
+        .filter(|m| m.spec.is_monotone())
+        .collect();
     v.extend(bundled().into_iter().filter(|m| m.spec.is_monotone()));
     v
 }

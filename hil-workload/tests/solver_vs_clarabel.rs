@@ -2,7 +2,9 @@
 //! 1e-6 on random ridge / box-constrained least-squares problems.
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus,
+};
 use hil_workload::features::SparseRow;
 use hil_workload::fit::{BoxLsq, Gram};
 use rand::{Rng, SeedableRng};
@@ -47,7 +49,11 @@ fn clarabel_solve(p: &BoxLsq<'_>) -> Vec<f64> {
     }
     let a = CscMatrix::new(m, k, colptr, rowval, nzval);
     let b: Vec<f64> = rows.iter().map(|r| r.2).collect();
-    let cones = if m > 0 { vec![NonnegativeConeT(m)] } else { vec![] };
+    let cones = if m > 0 {
+        vec![NonnegativeConeT(m)]
+    } else {
+        vec![]
+    };
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
         .tol_gap_abs(1e-12)
@@ -60,7 +66,10 @@ fn clarabel_solve(p: &BoxLsq<'_>) -> Vec<f64> {
     let mut solver = DefaultSolver::new(&pm, &q, &a, &b, &cones, settings).unwrap();
     solver.solve();
     assert!(
-        matches!(solver.solution.status, SolverStatus::Solved | SolverStatus::AlmostSolved),
+        matches!(
+            solver.solution.status,
+            SolverStatus::Solved | SolverStatus::AlmostSolved
+        ),
         "{:?}",
         solver.solution.status
     );
@@ -77,7 +86,8 @@ fn active_set_matches_clarabel() {
         let truth: Vec<f64> = (0..k).map(|_| rng.random_range(-1.0..1.0)).collect();
         for _ in 0..n {
             let x: Vec<f64> = (0..k).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let y = x.iter().zip(&truth).map(|(a, b)| a * b).sum::<f64>() + 0.3 * rng.random_range(-1.0..1.0);
+            let y = x.iter().zip(&truth).map(|(a, b)| a * b).sum::<f64>()
+                + 0.3 * rng.random_range(-1.0..1.0);
             g.add_row(&SparseRow {
                 entries: x.into_iter().enumerate().collect(),
                 y,
@@ -101,9 +111,15 @@ fn active_set_matches_clarabel() {
         let ours = p.solve(None).unwrap();
         let theirs = clarabel_solve(&p);
         for (a, b) in ours.iter().zip(&theirs) {
-            assert!((a - b).abs() < 1e-6, "case {case}: ours {ours:?} clarabel {theirs:?}");
+            assert!(
+                (a - b).abs() < 1e-6,
+                "case {case}: ours {ours:?} clarabel {theirs:?}"
+            );
         }
         // ours is at least as good (it is exact)
-        assert!(p.objective(&ours) <= p.objective(&theirs) + 1e-9, "case {case}");
+        assert!(
+            p.objective(&ours) <= p.objective(&theirs) + 1e-9,
+            "case {case}"
+        );
     }
 }

@@ -4,7 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use hil_core::{Difficulty, Distraction, HilError, QueryHistory, QueryKind, ResponseType, Result, Timestep, WorkloadModel};
+use hil_core::{
+    Difficulty, Distraction, HilError, QueryHistory, QueryKind, ResponseType, Result, Timestep,
+    WorkloadModel,
+};
 use hil_workload::bundle::{StudySummary, build_bundle, bundled_study};
 use hil_workload::datasets::{Dataset, DatasetId};
 use hil_workload::models::{FittedModel, Provenance};
@@ -135,10 +138,16 @@ const SYNTHETIC: &str = "Data: synthetic study calibrated to the paper's publish
 /// Runs `hil workload`.
 pub fn run(args: WorkloadArgs) -> Result<()> {
     match args.command {
-        WorkloadCommand::Generate { out, seed, config, quiet } => {
+        WorkloadCommand::Generate {
+            out,
+            seed,
+            config,
+            quiet,
+        } => {
             let cfg = match config {
                 Some(path) => {
-                    let text = std::fs::read_to_string(&path).map_err(|e| HilError::io("reading", &path, e))?;
+                    let text = std::fs::read_to_string(&path)
+                        .map_err(|e| HilError::io("reading", &path, e))?;
                     serde_json::from_str::<SynthConfig>(&text).map_err(|e| HilError::Data {
                         path: path.clone(),
                         record: e.line(),
@@ -151,16 +160,28 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let study = cfg.generate(seed)?;
             write(&out, &study.to_csv())?;
             if !quiet {
-                println!("wrote {} ({} surveys)", out.display(), study.records().len());
+                println!(
+                    "wrote {} ({} surveys)",
+                    out.display(),
+                    study.records().len()
+                );
                 print!("{}", StudySummary::of(&study)?.to_text());
                 println!("{SYNTHETIC}");
             }
             Ok(())
         }
-        WorkloadCommand::Select { data, out, cv, quiet } => {
+        WorkloadCommand::Select {
+            data,
+            out,
+            cv,
+            quiet,
+        } => {
             let study = Study::load(&data)?;
             let t0 = Instant::now();
-            let sets: Vec<Dataset> = DatasetId::ALL.iter().map(|&id| Dataset::build(&study, id)).collect::<Result<_>>()?;
+            let sets: Vec<Dataset> = DatasetId::ALL
+                .iter()
+                .map(|&id| Dataset::build(&study, id))
+                .collect::<Result<_>>()?;
             let refs: Vec<&Dataset> = sets.iter().collect();
             let opts = cv.options();
             let table = cross_validate(&refs, &Candidate::table(&opts.histories), &opts)?;
@@ -176,7 +197,9 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                             "selected on {}: {}{} (median test MSE {:.4})",
                             id.as_str().to_uppercase(),
                             b.candidate.label(),
-                            b.candidate.history().map_or(String::new(), |h| format!(" H = {h}")),
+                            b.candidate
+                                .history()
+                                .map_or(String::new(), |h| format!(" H = {h}")),
                             b.median
                         );
                     }
@@ -191,14 +214,27 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             );
             Ok(())
         }
-        WorkloadCommand::Fit { data, population, model, history, out, name, cv } => {
+        WorkloadCommand::Fit {
+            data,
+            population,
+            model,
+            history,
+            out,
+            name,
+            cv,
+        } => {
             let study = Study::load(&data)?;
             let id = DatasetId::parse(&population)?;
             let cand = Candidate::parse(&model, history)?;
             let d = Dataset::build(&study, id)?;
             let (spec, lambda) = fit_on_all(&d, cand, &cv.options())?;
             let name = name.unwrap_or_else(|| {
-                format!("{}_{}{}", model, id.as_str(), cand.history().map_or(String::new(), |h| format!("_h{h}")))
+                format!(
+                    "{}_{}{}",
+                    model,
+                    id.as_str(),
+                    cand.history().map_or(String::new(), |h| format!("_h{h}"))
+                )
             });
             let m = FittedModel::new(
                 name,
@@ -212,10 +248,22 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 },
             );
             m.save(&out)?;
-            println!("wrote {} ({} on {}, {} pairs)", out.display(), cand.label(), id.as_str().to_uppercase(), d.pairs.len());
+            println!(
+                "wrote {} ({} on {}, {} pairs)",
+                out.display(),
+                cand.label(),
+                id.as_str().to_uppercase(),
+                d.pairs.len()
+            );
             Ok(())
         }
-        WorkloadCommand::Rollout { model, schedule, wl0, steps, svg } => {
+        WorkloadCommand::Rollout {
+            model,
+            schedule,
+            wl0,
+            steps,
+            svg,
+        } => {
             let m: FittedModel = match model.strip_prefix("bundled:") {
                 Some(name) => hil_workload::bundled::load_fitted(name)?,
                 None => FittedModel::load(&model)?,
@@ -251,16 +299,30 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let csv = dir.join("data/synthetic_study.csv");
             write(&csv, &study.to_csv())?;
             let summary = StudySummary::of(&study)?;
-            let (table, models) = build_bundle(&study, "hil-workload/data/synthetic_study.csv", &cv.options())?;
-            write(&dir.join("data/selection.md"), &format!("{}\n{SYNTHETIC}\n", table.to_markdown()))?;
+            let (table, models) = build_bundle(
+                &study,
+                "hil-workload/data/synthetic_study.csv",
+                &cv.options(),
+            )?;
+            write(
+                &dir.join("data/selection.md"),
+                &format!("{}\n{SYNTHETIC}\n", table.to_markdown()),
+            )?;
             write(&dir.join("data/selection.csv"), &table.to_csv())?;
             write(&dir.join("data/summary.txt"), &summary.to_text())?;
             for m in &models {
                 m.save(dir.join(format!("models/{}.json", m.name)))?;
-                println!("wrote models/{}.json: {}", m.name, m.provenance.note.as_deref().unwrap_or(""));
+                println!(
+                    "wrote models/{}.json: {}",
+                    m.name,
+                    m.provenance.note.as_deref().unwrap_or("")
+                );
             }
             print!("{}", summary.to_text());
-            println!("bundle regenerated in {:.2} s. {SYNTHETIC}", t0.elapsed().as_secs_f64());
+            println!(
+                "bundle regenerated in {:.2} s. {SYNTHETIC}",
+                t0.elapsed().as_secs_f64()
+            );
             Ok(())
         }
     }
@@ -278,19 +340,36 @@ fn format_kind(k: &QueryKind) -> String {
 /// Parses `t:response/difficulty/distraction,...`.
 fn parse_schedule(s: &str) -> Result<Vec<(Timestep, QueryKind)>> {
     let mut out: Vec<(Timestep, QueryKind)> = Vec::new();
-    for (i, item) in s.split(',').map(str::trim).filter(|x| !x.is_empty()).enumerate() {
+    for (i, item) in s
+        .split(',')
+        .map(str::trim)
+        .filter(|x| !x.is_empty())
+        .enumerate()
+    {
         let bad = |why: String| HilError::invalid_parameter(format!("schedule[{i}]"), item, why);
         let (t, kind) = item.split_once(':').unwrap_or((item, ""));
-        let t: Timestep = t.trim().parse().map_err(|_| bad(format!("`{t}` is not a timestep (non-negative integer)")))?;
+        let t: Timestep = t
+            .trim()
+            .parse()
+            .map_err(|_| bad(format!("`{t}` is not a timestep (non-negative integer)")))?;
         let mut k = QueryKind::default();
-        for (j, part) in kind.split('/').map(str::trim).enumerate().filter(|(_, p)| !p.is_empty()) {
+        for (j, part) in kind
+            .split('/')
+            .map(str::trim)
+            .enumerate()
+            .filter(|(_, p)| !p.is_empty())
+        {
             match j {
                 0 => {
                     k.response = match part {
                         "mcq" => ResponseType::Mcq,
                         "bounding_box" | "bb" => ResponseType::BoundingBox,
                         "open_ended" | "oe" => ResponseType::OpenEnded,
-                        _ => return Err(bad(format!("unknown response type `{part}` (mcq, bounding_box, open_ended)"))),
+                        _ => {
+                            return Err(bad(format!(
+                                "unknown response type `{part}` (mcq, bounding_box, open_ended)"
+                            )));
+                        }
                     }
                 }
                 1 => {
@@ -305,16 +384,27 @@ fn parse_schedule(s: &str) -> Result<Vec<(Timestep, QueryKind)>> {
                         "none" => Distraction::None,
                         "easy" => Distraction::Easy,
                         "hard" => Distraction::Hard,
-                        _ => return Err(bad(format!("unknown distraction `{part}` (none, easy, hard)"))),
+                        _ => {
+                            return Err(bad(format!(
+                                "unknown distraction `{part}` (none, easy, hard)"
+                            )));
+                        }
                     }
                 }
-                _ => return Err(bad("expected at most response/difficulty/distraction".into())),
+                _ => {
+                    return Err(bad(
+                        "expected at most response/difficulty/distraction".into()
+                    ));
+                }
             }
         }
         if let Some(prev) = out.last()
             && t < prev.0
         {
-            return Err(bad(format!("times must not decrease (previous query at {})", prev.0)));
+            return Err(bad(format!(
+                "times must not decrease (previous query at {})",
+                prev.0
+            )));
         }
         out.push((t, k));
     }
@@ -327,7 +417,10 @@ fn svg_plot(name: &str, wl0: f64, points: &[(Timestep, f64, bool)]) -> String {
     let tmax = points.last().map_or(1, |p| p.0.max(1)) as f64;
     let x = |t: Timestep| m + (w - 2.0 * m) * t as f64 / tmax;
     let y = |v: f64| h - m - (h - 2.0 * m) * v;
-    let path: Vec<String> = points.iter().map(|&(t, v, _)| format!("{:.1},{:.1}", x(t), y(v))).collect();
+    let path: Vec<String> = points
+        .iter()
+        .map(|&(t, v, _)| format!("{:.1},{:.1}", x(t), y(v)))
+        .collect();
     let mut s = format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n\
          <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
@@ -349,7 +442,10 @@ fn svg_plot(name: &str, wl0: f64, points: &[(Timestep, f64, bool)]) -> String {
         let _ = q;
         s.push_str(&format!("<line x1=\"{0:.1}\" y1=\"{m}\" x2=\"{0:.1}\" y2=\"{1}\" stroke=\"#c33\" stroke-dasharray=\"3,3\"/>\n", x(t), h - m));
     }
-    s.push_str(&format!("<polyline fill=\"none\" stroke=\"#236\" stroke-width=\"2\" points=\"{}\"/>\n</svg>\n", path.join(" ")));
+    s.push_str(&format!(
+        "<polyline fill=\"none\" stroke=\"#236\" stroke-width=\"2\" points=\"{}\"/>\n</svg>\n",
+        path.join(" ")
+    ));
     s
 }
 
@@ -363,7 +459,12 @@ mod tests {
         assert_eq!(q.len(), 3);
         assert_eq!(q[1].1.response, ResponseType::OpenEnded);
         assert_eq!(q[2].1, QueryKind::default());
-        assert!(parse_schedule("3:telepathy").unwrap_err().to_string().contains("telepathy"));
+        assert!(
+            parse_schedule("3:telepathy")
+                .unwrap_err()
+                .to_string()
+                .contains("telepathy")
+        );
         assert!(parse_schedule("5,3").is_err());
     }
 }

@@ -93,6 +93,56 @@ impl Gram {
 /// factorisation. Directions whose pivot falls below `1e-11 × max pivot`
 /// are treated as dependent and get 0 (a basic least-squares solution).
 pub fn solve_psd(a: &[f64], k: usize, idx: &[usize], rhs: &[f64]) -> Vec<f64> {
+    if let Some(z) = solve_pd(a, k, idx, rhs) {
+        return z;
+    }
+    solve_pivoted(a, k, idx, rhs)
+}
+
+/// Unpivoted Cholesky (dot-product form on contiguous rows): the fast path
+/// for well-conditioned (e.g. ridge) systems. None if a pivot falls below
+/// the rank tolerance, in which case the pivoted path decides the rank.
+fn solve_pd(a: &[f64], k: usize, idx: &[usize], rhs: &[f64]) -> Option<Vec<f64>> {
+    let m = idx.len();
+    let max_diag = idx.iter().map(|&i| a[i * k + i]).fold(0.0f64, f64::max);
+    let tol = 1e-8 * max_diag.max(f64::MIN_POSITIVE);
+    let mut l = vec![0.0; m * m];
+    for (r, &i) in idx.iter().enumerate() {
+        for c in 0..=r {
+            let (row_r, row_c) = (&l[r * m..r * m + c], &l[c * m..c * m + c]);
+            let dot: f64 = row_r.iter().zip(row_c).map(|(x, y)| x * y).sum();
+            let v = a[i * k + idx[c]] - dot;
+            if c == r {
+                if v <= tol {
+                    return None;
+                }
+                l[r * m + r] = v.sqrt();
+            } else {
+                l[r * m + c] = v / l[c * m + c];
+            }
+        }
+    }
+    let mut z = rhs.to_vec();
+    for i in 0..m {
+        let dot: f64 = l[i * m..i * m + i]
+            .iter()
+            .zip(&z[..i])
+            .map(|(x, y)| x * y)
+            .sum();
+        z[i] = (z[i] - dot) / l[i * m + i];
+    }
+    for i in (0..m).rev() {
+        let mut s = z[i];
+        for r in i + 1..m {
+            s -= l[r * m + i] * z[r];
+        }
+        z[i] = s / l[i * m + i];
+    }
+    Some(z)
+}
+
+/// Diagonally pivoted Cholesky with rank detection (basic solution).
+fn solve_pivoted(a: &[f64], k: usize, idx: &[usize], rhs: &[f64]) -> Vec<f64> {
     let m = idx.len();
     let mut l = vec![0.0; m * m];
     for (r, &i) in idx.iter().enumerate() {
@@ -234,6 +284,26 @@ impl<'a> BoxLsq<'a> {
             h[i * k + i] += self.ridge[i];
         }
         let b = &self.gram.b;
+        // Without a warm start, begin at the unconstrained minimiser clipped
+        // to the box: most coefficients are then already on the right side
+        // of their bounds, so few active-set changes remain.
+        let bounded = (0..k).any(|i| self.lower[i].is_finite() || self.upper[i].is_finite());
+        let unconstrained;
+        let start = match start {
+            Some(s) => Some(s),
+            None if bounded => {
+                let all: Vec<usize> = (0..k).filter(|&i| h[i * k + i] > 0.0).collect();
+                let rhs: Vec<f64> = all.iter().map(|&i| b[i]).collect();
+                let z = solve_psd(&h, k, &all, &rhs);
+                let mut full = vec![0.0; k];
+                for (pos, &i) in all.iter().enumerate() {
+                    full[i] = z[pos];
+                }
+                unconstrained = full;
+                Some(unconstrained.as_slice())
+            }
+            None => None,
+        };
         let mut x: Vec<f64> = (0..k)
             .map(|i| {
                 start

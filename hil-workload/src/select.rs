@@ -549,16 +549,28 @@ impl SelectionTable {
             .find(|r| r.dataset == dataset && r.candidate == cand)
     }
 
-    /// The winner on `dataset`: lowest median test MSE (ties: lowest mean).
+    /// The winner on `dataset`: lowest median test MSE. Medians equal to
+    /// within 1e-9 (relative) are ties, broken by the lower mean, then by
+    /// table order (simpler models come first), so rounding noise between
+    /// equivalent fits does not flip the choice.
     pub fn best(&self, dataset: DatasetId) -> Option<&ScoreRow> {
-        self.rows
-            .iter()
-            .filter(|r| r.dataset == dataset)
-            .min_by(|a, b| {
-                a.median
-                    .total_cmp(&b.median)
-                    .then(a.mean.total_cmp(&b.mean))
-            })
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+        let mut best: Option<&ScoreRow> = None;
+        for r in self.rows.iter().filter(|r| r.dataset == dataset) {
+            best = match best {
+                None => Some(r),
+                Some(b) if close(r.median, b.median) => {
+                    if r.mean < b.mean && !close(r.mean, b.mean) {
+                        Some(r)
+                    } else {
+                        Some(b)
+                    }
+                }
+                Some(b) if r.median < b.median => Some(r),
+                keep => keep,
+            };
+        }
+        best
     }
 
     fn datasets(&self) -> Vec<DatasetId> {

@@ -161,3 +161,25 @@ fn selection_on_a_small_study() {
     assert_eq!(table.to_csv().lines().count(), 1 + table.rows.len());
     assert!(serde_json::from_str::<serde_json::Value>(&table.to_json()).is_ok());
 }
+
+#[test]
+fn bundled_models_are_reproducible_from_the_bundled_study() {
+    use hil_workload::models::ModelSpec;
+    let study = Study::load(concat!(env!("CARGO_MANIFEST_DIR"), "/data/synthetic_study.csv")).unwrap();
+    for name in hil_workload::bundled::NAMES {
+        let m = hil_workload::bundled::load_fitted(name).unwrap();
+        let id = DatasetId::parse(m.provenance.dataset.as_deref().unwrap()).unwrap();
+        let d = Dataset::build(&study, id).unwrap();
+        let cand = match &m.spec {
+            ModelSpec::Granger(g) => Candidate::Granger {
+                variant: g.variant,
+                h: g.history,
+            },
+            ModelSpec::Constant(_) => Candidate::Constant,
+            ModelSpec::Average(_) => Candidate::Average,
+            ModelSpec::ExpImpulse(_) => Candidate::ExpImpulse,
+        };
+        let (spec, _) = hil_workload::select::fit_on_all(&d, cand, &SelectOptions::default()).unwrap();
+        assert_eq!(spec, m.spec, "{name} is stale: run `hil workload bundle`");
+    }
+}

@@ -133,7 +133,7 @@ impl Candidate {
                 .ok_or_else(|| {
                     HilError::invalid_parameter(
                         "history",
-                        format!("{h:?}"),
+                        h.map_or("(missing)".to_string(), |h| h.to_string()),
                         "Granger models need --history H ≥ 1",
                     )
                 })

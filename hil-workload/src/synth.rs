@@ -64,6 +64,10 @@ pub struct SynthParams {
     pub survey_sd: f64,
     /// Per-subscale standard deviation.
     pub item_sd: f64,
+    /// Extra baseline (WL_0) level of people with limitations.
+    pub limited_baseline_shift: f64,
+    /// Per-survey standard deviation of people with limitations.
+    pub limited_survey_sd: f64,
 }
 
 impl Default for SynthParams {
@@ -83,6 +87,8 @@ impl Default for SynthParams {
             condition_sd: 0.06,
             survey_sd: 0.13,
             item_sd: 0.1,
+            limited_baseline_shift: 0.22,
+            limited_survey_sd: 0.22,
         }
     }
 }
@@ -178,8 +184,18 @@ impl SynthConfig {
             } else {
                 0.0
             };
-            let base_level =
-                p.mean + shift + p.baseline_offset + p.baseline_share * level + p.baseline_sd * z();
+            // people with limitations: a higher resting level and noisier answers
+            let (base_shift, survey_sd) = if pop.is_limited() {
+                (p.limited_baseline_shift, p.limited_survey_sd)
+            } else {
+                (0.0, p.survey_sd)
+            };
+            let base_level = p.mean
+                + shift
+                + base_shift
+                + p.baseline_offset
+                + p.baseline_share * level
+                + p.baseline_sd * z();
             let survey = |rng: &mut ChaCha8Rng, latent: f64| -> (TlxAnswers, Option<f64>) {
                 let mut item = |off: f64| -> u8 {
                     let v = (latent + off + p.item_sd * std_normal.sample(rng)).clamp(0.0, 1.0);
@@ -199,7 +215,7 @@ impl SynthConfig {
             {
                 let latent = base_level
                     + p.distraction[dist as usize]
-                    + p.survey_sd * std_normal.sample(&mut rng);
+                    + survey_sd * std_normal.sample(&mut rng);
                 let (tlx, st) = survey(&mut rng, latent);
                 records.push(StudyRecord {
                     participant: id.clone(),
@@ -235,7 +251,7 @@ impl SynthConfig {
                                 + p.response[response as usize]
                                 + p.distraction[distraction as usize]
                                 + carry
-                                + p.survey_sd * std_normal.sample(&mut rng);
+                                + survey_sd * std_normal.sample(&mut rng);
                             let (tlx, st) = survey(&mut rng, latent);
                             if pop.is_limited() {
                                 d2_query_rows.push(records.len());

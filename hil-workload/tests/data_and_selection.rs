@@ -165,7 +165,11 @@ fn selection_on_a_small_study() {
 #[test]
 fn bundled_models_are_reproducible_from_the_bundled_study() {
     use hil_workload::models::ModelSpec;
-    let study = Study::load(concat!(env!("CARGO_MANIFEST_DIR"), "/data/synthetic_study.csv")).unwrap();
+    let study = Study::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/synthetic_study.csv"
+    ))
+    .unwrap();
     for name in hil_workload::bundled::NAMES {
         let m = hil_workload::bundled::load_fitted(name).unwrap();
         let id = DatasetId::parse(m.provenance.dataset.as_deref().unwrap()).unwrap();
@@ -179,7 +183,8 @@ fn bundled_models_are_reproducible_from_the_bundled_study() {
             ModelSpec::Average(_) => Candidate::Average,
             ModelSpec::ExpImpulse(_) => Candidate::ExpImpulse,
         };
-        let (spec, _) = hil_workload::select::fit_on_all(&d, cand, &SelectOptions::default()).unwrap();
+        let (spec, _) =
+            hil_workload::select::fit_on_all(&d, cand, &SelectOptions::default()).unwrap();
         assert_eq!(spec, m.spec, "{name} is stale: run `hil workload bundle`");
     }
 }

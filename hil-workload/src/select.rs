@@ -213,6 +213,15 @@ pub fn median(xs: &[f64]) -> f64 {
     }
 }
 
+/// A training split (parts and inner CV groups) with its normal equations.
+#[derive(Debug)]
+pub struct Split {
+    train: Vec<usize>,
+    inner: Vec<Vec<usize>>,
+    g_train: Gram,
+    g_inner: Vec<Gram>,
+}
+
 /// The pairs of a dataset encoded once, split into parts, with the normal
 /// equations of each part.
 #[derive(Debug)]
@@ -301,23 +310,11 @@ impl<'a> Problem<'a> {
         p.solve(start)
     }
 
-    /// Fits a Granger variant on `train` parts; ridge variants pick λ from
-    /// `lambdas` by cross-validation over `inner` (groups of parts inside
-    /// `train`). Returns the coefficients and the λ used.
-    pub fn fit_granger(
-        &self,
-        variant: GrangerVariant,
-        h: usize,
-        train: &[usize],
-        inner: &[Vec<usize>],
-        lambdas: &[f64],
-    ) -> Result<(Vec<f64>, Option<f64>)> {
+    /// The normal equations of a training split and of its inner CV
+    /// training sets (computed once, shared by every candidate).
+    pub fn split(&self, train: &[usize], inner: &[Vec<usize>]) -> Split {
         let g_train = self.gram_of(train);
-        if !variant.is_ridge() {
-            return Ok((Self::solve(variant, &g_train, h, 0.0, None)?, None));
-        }
-        let mut best = (f64::INFINITY, lambdas[0]);
-        let inner_grams: Vec<Gram> = inner
+        let g_inner = inner
             .iter()
             .map(|grp| {
                 let mut g = g_train.clone();
@@ -325,40 +322,61 @@ impl<'a> Problem<'a> {
                 g
             })
             .collect();
-        let mut warm: Vec<Option<Vec<f64>>> = vec![None; inner.len()];
+        Split {
+            train: train.to_vec(),
+            inner: inner.to_vec(),
+            g_train,
+            g_inner,
+        }
+    }
+
+    /// Fits a Granger variant on `split`; ridge variants pick λ from
+    /// `lambdas` by cross-validation over the split's inner groups.
+    /// Returns the coefficients and the λ used.
+    pub fn fit_granger(
+        &self,
+        variant: GrangerVariant,
+        h: usize,
+        split: &Split,
+        lambdas: &[f64],
+    ) -> Result<(Vec<f64>, Option<f64>)> {
+        if !variant.is_ridge() {
+            return Ok((Self::solve(variant, &split.g_train, h, 0.0, None)?, None));
+        }
+        let mut best = (f64::INFINITY, lambdas[0]);
+        let mut warm: Vec<Option<Vec<f64>>> = vec![None; split.inner.len()];
         for &lambda in lambdas {
             let mut total = 0.0;
-            for (j, grp) in inner.iter().enumerate() {
-                let w = Self::solve(variant, &inner_grams[j], h, lambda, warm[j].as_deref())?;
+            for (j, grp) in split.inner.iter().enumerate() {
+                let w = Self::solve(variant, &split.g_inner[j], h, lambda, warm[j].as_deref())?;
                 total += self.mse_linear(grp, &w);
                 warm[j] = Some(w);
             }
-            let score = total / inner.len() as f64;
+            let score = total / split.inner.len() as f64;
             if score < best.0 {
                 best = (score, lambda);
             }
         }
         Ok((
-            Self::solve(variant, &g_train, h, best.1, None)?,
+            Self::solve(variant, &split.g_train, h, best.1, None)?,
             Some(best.1),
         ))
     }
 
-    /// Fits `cand` on `train` parts (inner groups tune ridge penalties).
+    /// Fits `cand` on `split` (inner groups tune ridge penalties).
     pub fn fit(
         &self,
         cand: Candidate,
-        train: &[usize],
-        inner: &[Vec<usize>],
+        split: &Split,
         lambdas: &[f64],
     ) -> Result<(ModelSpec, Option<f64>)> {
-        let pairs: Vec<&TrainingPair> = self.rows_of(train).map(|i| self.pairs[i]).collect();
+        let pairs: Vec<&TrainingPair> = self.rows_of(&split.train).map(|i| self.pairs[i]).collect();
         Ok(match cand {
             Candidate::Constant => (ModelSpec::Constant(ConstantModel {}), None),
             Candidate::Average => (ModelSpec::Average(AverageModel::fit(&pairs)?), None),
             Candidate::ExpImpulse => (ModelSpec::ExpImpulse(ExpImpulseModel::fit(&pairs)?), None),
             Candidate::Granger { variant, h } => {
-                let (w, lambda) = self.fit_granger(variant, h, train, inner, lambdas)?;
+                let (w, lambda) = self.fit_granger(variant, h, split, lambdas)?;
                 (
                     ModelSpec::Granger(GrangerModel::from_coefficients(variant, h, &w, lambda)?),
                     lambda,
@@ -475,9 +493,10 @@ pub fn cross_validate(
                         let (train, inner, test) =
                             fold_layout(o, opts.outer_folds, opts.inner_folds);
                         let p = &problems[d];
+                        let split = p.split(&train, &inner);
                         let mut scores = Vec::with_capacity(candidates.len());
                         for &c in candidates {
-                            let (spec, lambda) = p.fit(c, &train, &inner, &opts.lambdas)?;
+                            let (spec, lambda) = p.fit(c, &split, &opts.lambdas)?;
                             scores.push((p.test_mse(&test, &spec)?, lambda));
                         }
                         out.push((d, o, scores));
@@ -530,7 +549,7 @@ pub fn fit_on_all(
     );
     let train: Vec<usize> = (0..opts.inner_folds).collect();
     let inner: Vec<Vec<usize>> = (0..opts.inner_folds).map(|i| vec![i]).collect();
-    p.fit(cand, &train, &inner, &opts.lambdas)
+    p.fit(cand, &p.split(&train, &inner), &opts.lambdas)
 }
 
 fn fmt_num(x: f64) -> String {

@@ -24,6 +24,8 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Workload study data and models: generate, select, fit, rollout, bundle.
     Workload(cmd::workload::WorkloadArgs),
+    /// Inspect plugin libraries and check their types for conformance.
+    Plugins(cmd::plugins::PluginsArgs),
 }
 
 fn main() -> ExitCode {
@@ -33,10 +35,12 @@ fn main() -> ExitCode {
     hil_workload::link();
     hil_envs::link();
     hil_kinova_mujoco::link();
+    hil_channels::link();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Workload(args) => cmd::workload::run(args),
+        Command::Plugins(args) => cmd::plugins::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

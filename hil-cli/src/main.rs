@@ -22,6 +22,8 @@ struct Cli {
 enum Command {
     /// Run an experiment described by a TOML config.
     Run(cmd::run::RunArgs),
+    /// Workload study data and models: generate, select, fit, rollout, bundle.
+    Workload(cmd::workload::WorkloadArgs),
     /// Inspect plugin libraries and check their types for conformance.
     Plugins(cmd::plugins::PluginsArgs),
     /// Benchmark components (e.g. `hil bench policy --policy linucb_qg`).
@@ -39,6 +41,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Workload(args) => cmd::workload::run(args),
         Command::Plugins(args) => cmd::plugins::run(args),
         Command::Bench(args) => cmd::bench::run(args),
     };

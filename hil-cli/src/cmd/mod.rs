@@ -1,6 +1,6 @@
 //! One module per subcommand.
 
-pub mod plugins;
 pub mod bench;
+pub mod plugins;
 pub mod run;
 pub mod workload;

@@ -5,7 +5,7 @@
 //! label and contrast checks on the live page.
 //!
 //! Needs Debian's `chromium` and `chromium-driver` (installed by
-//! `scripts/setup-chromium`, which `scripts/test` and CI run first). The
+//! `scripts/test-setup-chromium`, which `scripts/test` and CI run first). The
 //! test fails if they are missing, unless HIL_SKIP_BROWSER_TESTS=1.
 
 use std::io::{Read, Write};
@@ -277,7 +277,7 @@ fn tools_present() -> bool {
         eprintln!("SKIPPED: chromium/chromedriver missing and HIL_SKIP_BROWSER_TESTS is set");
         return false;
     }
-    panic!("{CHROMIUM} and {CHROMEDRIVER} are needed: run scripts/setup-chromium");
+    panic!("{CHROMIUM} and {CHROMEDRIVER} are needed: run scripts/test-setup-chromium");
 }
 
 /// WCAG relative luminance contrast of two `rgb(...)` colours.

@@ -49,17 +49,26 @@ impl StudySummary {
             (Some(a), Some(b)) => Some(mann_whitney_u(a, b, Alternative::Less)?),
             _ => None,
         };
-        Ok(Self { datasets, d1_less_than_d2 })
+        Ok(Self {
+            datasets,
+            d1_less_than_d2,
+        })
     }
 
     /// A human-readable summary.
     pub fn to_text(&self) -> String {
         let mut s = String::new();
         for (id, n, m, sd, wl0) in &self.datasets {
-            s.push_str(&format!("{}: {n} pairs, WL {m:.3} ± {sd:.3}, mean WL_0 {wl0:.3}\n", id.as_str().to_uppercase()));
+            s.push_str(&format!(
+                "{}: {n} pairs, WL {m:.3} ± {sd:.3}, mean WL_0 {wl0:.3}\n",
+                id.as_str().to_uppercase()
+            ));
         }
         if let Some(t) = &self.d1_less_than_d2 {
-            s.push_str(&format!("Mann-Whitney U (D1 < D2): U = {}, p = {:.3e}\n", t.statistic, t.p_value));
+            s.push_str(&format!(
+                "Mann-Whitney U (D1 < D2): U = {}, p = {:.3e}\n",
+                t.statistic, t.p_value
+            ));
         }
         s
     }
@@ -67,8 +76,15 @@ impl StudySummary {
 
 /// Fits the five bundled models from `study` and returns them with the
 /// selection table on all three datasets.
-pub fn build_bundle(study: &Study, data_label: &str, opts: &SelectOptions) -> Result<(SelectionTable, Vec<FittedModel>)> {
-    let sets: Vec<Dataset> = DatasetId::ALL.iter().map(|&id| Dataset::build(study, id)).collect::<Result<_>>()?;
+pub fn build_bundle(
+    study: &Study,
+    data_label: &str,
+    opts: &SelectOptions,
+) -> Result<(SelectionTable, Vec<FittedModel>)> {
+    let sets: Vec<Dataset> = DatasetId::ALL
+        .iter()
+        .map(|&id| Dataset::build(study, id))
+        .collect::<Result<_>>()?;
     let refs: Vec<&Dataset> = sets.iter().collect();
     let table = cross_validate(&refs, &Candidate::table(&opts.histories), opts)?;
     let sim = Candidate::Granger {
@@ -78,7 +94,11 @@ pub fn build_bundle(study: &Study, data_label: &str, opts: &SelectOptions) -> Re
     let sim_table = cross_validate(&refs, &[sim], opts)?;
     let note = "fitted on synthetic study data calibrated to the paper's published figures; not real participant data";
     let mut models = Vec::new();
-    for (d, name) in [(&sets[0], "f1_sim"), (&sets[1], "f2_sim"), (&sets[2], "f12_sim")] {
+    for (d, name) in [
+        (&sets[0], "f1_sim"),
+        (&sets[1], "f2_sim"),
+        (&sets[2], "f12_sim"),
+    ] {
         let (spec, _) = fit_on_all(d, sim, opts)?;
         let row = sim_table.row(d.id, sim).expect("scored above");
         models.push(FittedModel::new(
@@ -89,7 +109,9 @@ pub fn build_bundle(study: &Study, data_label: &str, opts: &SelectOptions) -> Re
                 data: Some(data_label.into()),
                 n_pairs: Some(d.pairs.len()),
                 cv_test_mse: Some([row.mean, row.std, row.median]),
-                note: Some(format!("simulation variant (Granger H = 10, bounds [0.05, 1], w_0 ≤ 1); {note}")),
+                note: Some(format!(
+                    "simulation variant (Granger H = 10, bounds [0.05, 1], w_0 ≤ 1); {note}"
+                )),
             },
         ));
     }
@@ -107,7 +129,9 @@ pub fn build_bundle(study: &Study, data_label: &str, opts: &SelectOptions) -> Re
                 note: Some(format!(
                     "lowest median CV test MSE: {}{}{}; {note}",
                     best.candidate.label(),
-                    best.candidate.history().map_or(String::new(), |h| format!(" H = {h}")),
+                    best.candidate
+                        .history()
+                        .map_or(String::new(), |h| format!(" H = {h}")),
                     lambda.map_or(String::new(), |l| format!(", λ = {l}")),
                 )),
             },

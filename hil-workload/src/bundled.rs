@@ -32,7 +32,14 @@ pub fn json(name: &str) -> Option<&'static str> {
 /// Loads a bundled model with its metadata.
 pub fn load_fitted(name: &str) -> Result<FittedModel> {
     let text = json(name).ok_or_else(|| {
-        HilError::invalid_parameter("name", name, format!("no bundled workload model by that name; available: {}", NAMES.join(", ")))
+        HilError::invalid_parameter(
+            "name",
+            name,
+            format!(
+                "no bundled workload model by that name; available: {}",
+                NAMES.join(", ")
+            ),
+        )
     })?;
     FittedModel::from_json(text, format!("<bundled {name}.json>").as_ref())
 }

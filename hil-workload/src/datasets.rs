@@ -58,7 +58,11 @@ impl DatasetId {
             "d1" => Ok(Self::D1),
             "d2" => Ok(Self::D2),
             "d12" | "d1,2" | "d1_2" => Ok(Self::D12),
-            _ => Err(HilError::invalid_parameter("population", s, "expected d1, d2 or d12")),
+            _ => Err(HilError::invalid_parameter(
+                "population",
+                s,
+                "expected d1, d2 or d12",
+            )),
         }
     }
 

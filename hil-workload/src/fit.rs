@@ -93,6 +93,56 @@ impl Gram {
 /// factorisation. Directions whose pivot falls below `1e-11 × max pivot`
 /// are treated as dependent and get 0 (a basic least-squares solution).
 pub fn solve_psd(a: &[f64], k: usize, idx: &[usize], rhs: &[f64]) -> Vec<f64> {
+    if let Some(z) = solve_pd(a, k, idx, rhs) {
+        return z;
+    }
+    solve_pivoted(a, k, idx, rhs)
+}
+
+/// Unpivoted Cholesky (dot-product form on contiguous rows): the fast path
+/// for well-conditioned (e.g. ridge) systems. None if a pivot falls below
+/// the rank tolerance, in which case the pivoted path decides the rank.
+fn solve_pd(a: &[f64], k: usize, idx: &[usize], rhs: &[f64]) -> Option<Vec<f64>> {
+    let m = idx.len();
+    let max_diag = idx.iter().map(|&i| a[i * k + i]).fold(0.0f64, f64::max);
+    let tol = 1e-8 * max_diag.max(f64::MIN_POSITIVE);
+    let mut l = vec![0.0; m * m];
+    for (r, &i) in idx.iter().enumerate() {
+        for c in 0..=r {
+            let (row_r, row_c) = (&l[r * m..r * m + c], &l[c * m..c * m + c]);
+            let dot: f64 = row_r.iter().zip(row_c).map(|(x, y)| x * y).sum();
+            let v = a[i * k + idx[c]] - dot;
+            if c == r {
+                if v <= tol {
+                    return None;
+                }
+                l[r * m + r] = v.sqrt();
+            } else {
+                l[r * m + c] = v / l[c * m + c];
+            }
+        }
+    }
+    let mut z = rhs.to_vec();
+    for i in 0..m {
+        let dot: f64 = l[i * m..i * m + i]
+            .iter()
+            .zip(&z[..i])
+            .map(|(x, y)| x * y)
+            .sum();
+        z[i] = (z[i] - dot) / l[i * m + i];
+    }
+    for i in (0..m).rev() {
+        let mut s = z[i];
+        for r in i + 1..m {
+            s -= l[r * m + i] * z[r];
+        }
+        z[i] = s / l[i * m + i];
+    }
+    Some(z)
+}
+
+/// Diagonally pivoted Cholesky with rank detection (basic solution).
+fn solve_pivoted(a: &[f64], k: usize, idx: &[usize], rhs: &[f64]) -> Vec<f64> {
     let m = idx.len();
     let mut l = vec![0.0; m * m];
     for (r, &i) in idx.iter().enumerate() {
@@ -108,7 +158,10 @@ pub fn solve_psd(a: &[f64], k: usize, idx: &[usize], rhs: &[f64]) -> Vec<f64> {
         // pick the largest remaining pivot
         let (p, piv) = (j..m)
             .map(|i| (i, l[i * m + i]))
-            .fold((j, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc });
+            .fold(
+                (j, f64::NEG_INFINITY),
+                |acc, x| if x.1 > acc.1 { x } else { acc },
+            );
         if piv <= tol {
             break;
         }
@@ -197,7 +250,8 @@ impl<'a> BoxLsq<'a> {
         let k = self.gram.k;
         let mut s = 0.0;
         for i in 0..k {
-            let gw: f64 = (0..k).map(|j| self.gram.g[i * k + j] * w[j]).sum::<f64>() + self.ridge[i] * w[i];
+            let gw: f64 =
+                (0..k).map(|j| self.gram.g[i * k + j] * w[j]).sum::<f64>() + self.ridge[i] * w[i];
             s += 0.5 * w[i] * gw - self.gram.b[i] * w[i];
         }
         s
@@ -208,11 +262,21 @@ impl<'a> BoxLsq<'a> {
     pub fn solve(&self, start: Option<&[f64]>) -> Result<Vec<f64>> {
         let k = self.gram.k;
         if self.ridge.len() != k || self.lower.len() != k || self.upper.len() != k {
-            return Err(HilError::invalid_input("least-squares problem", "bounds or penalties have the wrong length"));
+            return Err(HilError::invalid_input(
+                "least-squares problem",
+                "bounds or penalties have the wrong length",
+            ));
         }
         for i in 0..k {
-            if self.lower[i] > self.upper[i] || self.ridge[i] < 0.0 || self.lower[i].is_nan() || self.upper[i].is_nan() {
-                return Err(HilError::invalid_input("least-squares problem", format!("coefficient {i} has empty bounds or a negative penalty")));
+            if self.lower[i] > self.upper[i]
+                || self.ridge[i] < 0.0
+                || self.lower[i].is_nan()
+                || self.upper[i].is_nan()
+            {
+                return Err(HilError::invalid_input(
+                    "least-squares problem",
+                    format!("coefficient {i} has empty bounds or a negative penalty"),
+                ));
             }
         }
         let mut h = self.gram.g.clone();
@@ -220,8 +284,32 @@ impl<'a> BoxLsq<'a> {
             h[i * k + i] += self.ridge[i];
         }
         let b = &self.gram.b;
+        // Without a warm start, begin at the unconstrained minimiser clipped
+        // to the box: most coefficients are then already on the right side
+        // of their bounds, so few active-set changes remain.
+        let bounded = (0..k).any(|i| self.lower[i].is_finite() || self.upper[i].is_finite());
+        let unconstrained;
+        let start = match start {
+            Some(s) => Some(s),
+            None if bounded => {
+                let all: Vec<usize> = (0..k).filter(|&i| h[i * k + i] > 0.0).collect();
+                let rhs: Vec<f64> = all.iter().map(|&i| b[i]).collect();
+                let z = solve_psd(&h, k, &all, &rhs);
+                let mut full = vec![0.0; k];
+                for (pos, &i) in all.iter().enumerate() {
+                    full[i] = z[pos];
+                }
+                unconstrained = full;
+                Some(unconstrained.as_slice())
+            }
+            None => None,
+        };
         let mut x: Vec<f64> = (0..k)
-            .map(|i| start.map_or(0.0, |s| s[i]).clamp(self.lower[i], self.upper[i]))
+            .map(|i| {
+                start
+                    .map_or(0.0, |s| s[i])
+                    .clamp(self.lower[i], self.upper[i])
+            })
             .collect();
         // Coefficients of all-zero columns do not affect the objective:
         // they stay at their (projected) start value.
@@ -231,7 +319,9 @@ impl<'a> BoxLsq<'a> {
             .collect();
         let scale = b.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         let tol = 1e-10 * scale;
-        let grad = |x: &[f64], i: usize| -> f64 { (0..k).map(|j| h[i * k + j] * x[j]).sum::<f64>() - b[i] };
+        let grad = |x: &[f64], i: usize| -> f64 {
+            (0..k).map(|j| h[i * k + j] * x[j]).sum::<f64>() - b[i]
+        };
         let max_iter = 20 * k + 200;
         for _ in 0..max_iter {
             let idx: Vec<usize> = (0..k).filter(|&i| free[i]).collect();
@@ -313,7 +403,10 @@ mod tests {
         let rows: Vec<_> = (0..10)
             .map(|i| {
                 let a = i as f64;
-                (vec![1.0, a, (a * 0.7).sin()], 2.0 - 0.5 * a + 3.0 * (a * 0.7).sin())
+                (
+                    vec![1.0, a, (a * 0.7).sin()],
+                    2.0 - 0.5 * a + 3.0 * (a * 0.7).sin(),
+                )
             })
             .collect();
         let g = gram_of(&rows);
@@ -335,7 +428,10 @@ mod tests {
         let g = gram_of(&rows);
         let p = BoxLsq::plain(&g);
         let w = p.solve(None).unwrap();
-        let resid: f64 = rows.iter().map(|(x, y)| (x.iter().zip(&w).map(|(a, b)| a * b).sum::<f64>() - y).powi(2)).sum();
+        let resid: f64 = rows
+            .iter()
+            .map(|(x, y)| (x.iter().zip(&w).map(|(a, b)| a * b).sum::<f64>() - y).powi(2))
+            .sum();
         assert!(resid < 1e-18, "{w:?} {resid}");
     }
 
@@ -344,7 +440,10 @@ mod tests {
         let rows: Vec<_> = (0..12)
             .map(|i| {
                 let a = i as f64;
-                (vec![1.0, a, (a * 1.3).cos()], 1.0 - 0.3 * a + 0.2 * (a * 1.3).cos())
+                (
+                    vec![1.0, a, (a * 1.3).cos()],
+                    1.0 - 0.3 * a + 0.2 * (a * 1.3).cos(),
+                )
             })
             .collect();
         let g = gram_of(&rows);
@@ -354,7 +453,9 @@ mod tests {
         assert!(w[1] >= 0.0 && w[2] >= 0.0);
         assert_eq!(w[1], 0.0, "{w:?}");
         // KKT: gradient zero on free coordinates, ≥ 0 at the lower bound
-        let gr: Vec<f64> = (0..3).map(|i| (0..3).map(|j| g.g[i * 3 + j] * w[j]).sum::<f64>() - g.b[i]).collect();
+        let gr: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|j| g.g[i * 3 + j] * w[j]).sum::<f64>() - g.b[i])
+            .collect();
         assert!(gr[0].abs() < 1e-9 && gr[1] >= -1e-9, "{gr:?}");
     }
 }

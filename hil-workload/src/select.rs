@@ -22,7 +22,9 @@ use serde::{Deserialize, Serialize};
 use crate::datasets::{Dataset, DatasetId, TrainingPair};
 use crate::features::{SparseRow, n_columns};
 use crate::fit::{BoxLsq, Gram};
-use crate::models::{AverageModel, ConstantModel, ExpImpulseModel, GrangerModel, GrangerVariant, ModelSpec};
+use crate::models::{
+    AverageModel, ConstantModel, ExpImpulseModel, GrangerModel, GrangerVariant, ModelSpec,
+};
 
 /// Options of a selection run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -58,13 +60,25 @@ impl Default for SelectOptions {
 impl SelectOptions {
     fn validate(&self) -> Result<()> {
         if self.outer_folds < 2 || self.inner_folds < 2 {
-            return Err(HilError::invalid_parameter("folds", format!("{}/{}", self.outer_folds, self.inner_folds), "need at least 2 outer and 2 inner folds"));
+            return Err(HilError::invalid_parameter(
+                "folds",
+                format!("{}/{}", self.outer_folds, self.inner_folds),
+                "need at least 2 outer and 2 inner folds",
+            ));
         }
         if self.histories.is_empty() || self.histories.contains(&0) {
-            return Err(HilError::invalid_parameter("histories", format!("{:?}", self.histories), "need at least one H ≥ 1"));
+            return Err(HilError::invalid_parameter(
+                "histories",
+                format!("{:?}", self.histories),
+                "need at least one H ≥ 1",
+            ));
         }
         if self.lambdas.is_empty() || self.lambdas.iter().any(|l| !(l.is_finite() && *l >= 0.0)) {
-            return Err(HilError::invalid_parameter("lambdas", format!("{:?}", self.lambdas), "need at least one finite λ ≥ 0"));
+            return Err(HilError::invalid_parameter(
+                "lambdas",
+                format!("{:?}", self.lambdas),
+                "need at least one finite λ ≥ 0",
+            ));
         }
         Ok(())
     }
@@ -116,7 +130,13 @@ impl Candidate {
             h.or(default)
                 .filter(|h| *h >= 1)
                 .map(|h| Self::Granger { variant, h })
-                .ok_or_else(|| HilError::invalid_parameter("history", format!("{h:?}"), "Granger models need --history H ≥ 1"))
+                .ok_or_else(|| {
+                    HilError::invalid_parameter(
+                        "history",
+                        h.map_or("(missing)".to_string(), |h| h.to_string()),
+                        "Granger models need --history H ≥ 1",
+                    )
+                })
         };
         match name {
             "constant" => Ok(Self::Constant),
@@ -186,7 +206,20 @@ pub fn median(xs: &[f64]) -> f64 {
     if n == 0 {
         return f64::NAN;
     }
-    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// A training split (parts and inner CV groups) with its normal equations.
+#[derive(Debug)]
+pub struct Split {
+    train: Vec<usize>,
+    inner: Vec<Vec<usize>>,
+    g_train: Gram,
+    g_inner: Vec<Gram>,
 }
 
 /// The pairs of a dataset encoded once, split into parts, with the normal
@@ -231,7 +264,9 @@ impl<'a> Problem<'a> {
     }
 
     fn rows_of<'s>(&'s self, parts: &'s [usize]) -> impl Iterator<Item = usize> + 's {
-        parts.iter().flat_map(move |&p| self.part_rows[p].iter().copied())
+        parts
+            .iter()
+            .flat_map(move |&p| self.part_rows[p].iter().copied())
     }
 
     fn mse_linear(&self, parts: &[usize], w: &[f64]) -> f64 {
@@ -256,7 +291,13 @@ impl<'a> Problem<'a> {
         Ok(s / n.max(1) as f64)
     }
 
-    fn solve(variant: GrangerVariant, gram: &Gram, h: usize, lambda: f64, start: Option<&[f64]>) -> Result<Vec<f64>> {
+    fn solve(
+        variant: GrangerVariant,
+        gram: &Gram,
+        h: usize,
+        lambda: f64,
+        start: Option<&[f64]>,
+    ) -> Result<Vec<f64>> {
         let k = n_columns(h);
         let g = gram.prefix(k);
         let (lower, upper) = variant.bounds(h);
@@ -269,23 +310,11 @@ impl<'a> Problem<'a> {
         p.solve(start)
     }
 
-    /// Fits a Granger variant on `train` parts; ridge variants pick λ from
-    /// `lambdas` by cross-validation over `inner` (groups of parts inside
-    /// `train`). Returns the coefficients and the λ used.
-    pub fn fit_granger(
-        &self,
-        variant: GrangerVariant,
-        h: usize,
-        train: &[usize],
-        inner: &[Vec<usize>],
-        lambdas: &[f64],
-    ) -> Result<(Vec<f64>, Option<f64>)> {
+    /// The normal equations of a training split and of its inner CV
+    /// training sets (computed once, shared by every candidate).
+    pub fn split(&self, train: &[usize], inner: &[Vec<usize>]) -> Split {
         let g_train = self.gram_of(train);
-        if !variant.is_ridge() {
-            return Ok((Self::solve(variant, &g_train, h, 0.0, None)?, None));
-        }
-        let mut best = (f64::INFINITY, lambdas[0]);
-        let inner_grams: Vec<Gram> = inner
+        let g_inner = inner
             .iter()
             .map(|grp| {
                 let mut g = g_train.clone();
@@ -293,32 +322,65 @@ impl<'a> Problem<'a> {
                 g
             })
             .collect();
-        let mut warm: Vec<Option<Vec<f64>>> = vec![None; inner.len()];
+        Split {
+            train: train.to_vec(),
+            inner: inner.to_vec(),
+            g_train,
+            g_inner,
+        }
+    }
+
+    /// Fits a Granger variant on `split`; ridge variants pick λ from
+    /// `lambdas` by cross-validation over the split's inner groups.
+    /// Returns the coefficients and the λ used.
+    pub fn fit_granger(
+        &self,
+        variant: GrangerVariant,
+        h: usize,
+        split: &Split,
+        lambdas: &[f64],
+    ) -> Result<(Vec<f64>, Option<f64>)> {
+        if !variant.is_ridge() {
+            return Ok((Self::solve(variant, &split.g_train, h, 0.0, None)?, None));
+        }
+        let mut best = (f64::INFINITY, lambdas[0]);
+        let mut warm: Vec<Option<Vec<f64>>> = vec![None; split.inner.len()];
         for &lambda in lambdas {
             let mut total = 0.0;
-            for (j, grp) in inner.iter().enumerate() {
-                let w = Self::solve(variant, &inner_grams[j], h, lambda, warm[j].as_deref())?;
+            for (j, grp) in split.inner.iter().enumerate() {
+                let w = Self::solve(variant, &split.g_inner[j], h, lambda, warm[j].as_deref())?;
                 total += self.mse_linear(grp, &w);
                 warm[j] = Some(w);
             }
-            let score = total / inner.len() as f64;
+            let score = total / split.inner.len() as f64;
             if score < best.0 {
                 best = (score, lambda);
             }
         }
-        Ok((Self::solve(variant, &g_train, h, best.1, None)?, Some(best.1)))
+        Ok((
+            Self::solve(variant, &split.g_train, h, best.1, None)?,
+            Some(best.1),
+        ))
     }
 
-    /// Fits `cand` on `train` parts (inner groups tune ridge penalties).
-    pub fn fit(&self, cand: Candidate, train: &[usize], inner: &[Vec<usize>], lambdas: &[f64]) -> Result<(ModelSpec, Option<f64>)> {
-        let pairs: Vec<&TrainingPair> = self.rows_of(train).map(|i| self.pairs[i]).collect();
+    /// Fits `cand` on `split` (inner groups tune ridge penalties).
+    pub fn fit(
+        &self,
+        cand: Candidate,
+        split: &Split,
+        lambdas: &[f64],
+    ) -> Result<(ModelSpec, Option<f64>)> {
+        let pairs: Vec<&TrainingPair> = self.rows_of(&split.train).map(|i| self.pairs[i]).collect();
         Ok(match cand {
             Candidate::Constant => (ModelSpec::Constant(ConstantModel {}), None),
             Candidate::Average => (ModelSpec::Average(AverageModel::fit(&pairs)?), None),
             Candidate::ExpImpulse => (ModelSpec::ExpImpulse(ExpImpulseModel::fit(&pairs)?), None),
             Candidate::Granger { variant, h } => {
-                let (w, lambda) = self.fit_granger(variant, h, train, inner, lambdas)?;
-                (ModelSpec::Granger(GrangerModel::from_coefficients(variant, h, &w, lambda)?), lambda)
+                let (w, lambda) = self.fit_granger(variant, h, split, lambdas)?;
+                (
+                    ModelSpec::Granger(GrangerModel::from_coefficients(variant, h, &w, lambda)?),
+                    lambda,
+                )
             }
         })
     }
@@ -332,11 +394,19 @@ impl<'a> Problem<'a> {
     }
 }
 
+/// Per-fold (test MSE, chosen λ) of one candidate.
+type FoldScores = Vec<(f64, Option<f64>)>;
+
 /// Outer fold `o` of a K×J part layout: (train parts, inner groups, test parts).
 fn fold_layout(o: usize, k: usize, j: usize) -> (Vec<usize>, Vec<Vec<usize>>, Vec<usize>) {
     let part = |outer: usize, inner: usize| outer * j + inner;
-    let train: Vec<usize> = (0..k).filter(|&x| x != o).flat_map(|x| (0..j).map(move |i| part(x, i))).collect();
-    let inner: Vec<Vec<usize>> = (0..j).map(|i| (0..k).filter(|&x| x != o).map(|x| part(x, i)).collect()).collect();
+    let train: Vec<usize> = (0..k)
+        .filter(|&x| x != o)
+        .flat_map(|x| (0..j).map(move |i| part(x, i)))
+        .collect();
+    let inner: Vec<Vec<usize>> = (0..j)
+        .map(|i| (0..k).filter(|&x| x != o).map(|x| part(x, i)).collect())
+        .collect();
     let test: Vec<usize> = (0..j).map(|i| part(o, i)).collect();
     (train, inner, test)
 }
@@ -374,9 +444,17 @@ fn score_row(dataset: DatasetId, candidate: Candidate, fold: Vec<(f64, Option<f6
 /// let best = table.best(DatasetId::D12).unwrap();
 /// assert!(best.median < table.row(DatasetId::D12, Candidate::Constant).unwrap().median);
 /// ```
-pub fn cross_validate(datasets: &[&Dataset], candidates: &[Candidate], opts: &SelectOptions) -> Result<SelectionTable> {
+pub fn cross_validate(
+    datasets: &[&Dataset],
+    candidates: &[Candidate],
+    opts: &SelectOptions,
+) -> Result<SelectionTable> {
     opts.validate()?;
-    let h_max = candidates.iter().filter_map(Candidate::history).max().unwrap_or(1);
+    let h_max = candidates
+        .iter()
+        .filter_map(Candidate::history)
+        .max()
+        .unwrap_or(1);
     let problems: Vec<Problem<'_>> = datasets
         .iter()
         .map(|d| Problem::new(&d.pairs, h_max, n_parts(opts), opts.seed))
@@ -385,19 +463,25 @@ pub fn cross_validate(datasets: &[&Dataset], candidates: &[Candidate], opts: &Se
         if p.part_rows.iter().any(Vec::is_empty) {
             return Err(HilError::invalid_input(
                 format!("dataset {}", d.id.as_str()),
-                format!("{} pairs are too few for {}×{} folds", d.pairs.len(), opts.outer_folds, opts.inner_folds),
+                format!(
+                    "{} pairs are too few for {}×{} folds",
+                    d.pairs.len(),
+                    opts.outer_folds,
+                    opts.inner_folds
+                ),
             ));
         }
     }
     // one task per (dataset, outer fold)
-    let tasks: Vec<(usize, usize)> = (0..datasets.len()).flat_map(|d| (0..opts.outer_folds).map(move |o| (d, o))).collect();
+    let tasks: Vec<(usize, usize)> = (0..datasets.len())
+        .flat_map(|d| (0..opts.outer_folds).map(move |o| (d, o)))
+        .collect();
     let next = AtomicUsize::new(0);
     let threads = if opts.threads == 0 {
         std::thread::available_parallelism().map_or(1, |n| n.get())
     } else {
         opts.threads
     };
-    type FoldScores = Vec<(f64, Option<f64>)>;
     let results: Vec<Result<Vec<(usize, usize, FoldScores)>>> = std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads.min(tasks.len()))
             .map(|_| {
@@ -406,11 +490,13 @@ pub fn cross_validate(datasets: &[&Dataset], candidates: &[Candidate], opts: &Se
                     loop {
                         let i = next.fetch_add(1, Ordering::Relaxed);
                         let Some(&(d, o)) = tasks.get(i) else { break };
-                        let (train, inner, test) = fold_layout(o, opts.outer_folds, opts.inner_folds);
+                        let (train, inner, test) =
+                            fold_layout(o, opts.outer_folds, opts.inner_folds);
                         let p = &problems[d];
+                        let split = p.split(&train, &inner);
                         let mut scores = Vec::with_capacity(candidates.len());
                         for &c in candidates {
-                            let (spec, lambda) = p.fit(c, &train, &inner, &opts.lambdas)?;
+                            let (spec, lambda) = p.fit(c, &split, &opts.lambdas)?;
                             scores.push((p.test_mse(&test, &spec)?, lambda));
                         }
                         out.push((d, o, scores));
@@ -419,9 +505,12 @@ pub fn cross_validate(datasets: &[&Dataset], candidates: &[Candidate], opts: &Se
                 })
             })
             .collect();
-        handles.into_iter().map(|h| h.join().expect("selection worker panicked")).collect()
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("selection worker panicked"))
+            .collect()
     });
-    let mut per: Vec<Vec<Vec<(f64, Option<f64>)>>> = vec![vec![Vec::new(); candidates.len()]; datasets.len()];
+    let mut per: Vec<Vec<FoldScores>> = vec![vec![Vec::new(); candidates.len()]; datasets.len()];
     let mut flat = Vec::new();
     for r in results {
         flat.extend(r?);
@@ -446,12 +535,21 @@ pub fn cross_validate(datasets: &[&Dataset], candidates: &[Candidate], opts: &Se
 }
 
 /// Fits `cand` on the whole dataset; ridge penalties by inner CV on it.
-pub fn fit_on_all(dataset: &Dataset, cand: Candidate, opts: &SelectOptions) -> Result<(ModelSpec, Option<f64>)> {
+pub fn fit_on_all(
+    dataset: &Dataset,
+    cand: Candidate,
+    opts: &SelectOptions,
+) -> Result<(ModelSpec, Option<f64>)> {
     opts.validate()?;
-    let p = Problem::new(&dataset.pairs, cand.history().unwrap_or(1), opts.inner_folds, opts.seed);
+    let p = Problem::new(
+        &dataset.pairs,
+        cand.history().unwrap_or(1),
+        opts.inner_folds,
+        opts.seed,
+    );
     let train: Vec<usize> = (0..opts.inner_folds).collect();
     let inner: Vec<Vec<usize>> = (0..opts.inner_folds).map(|i| vec![i]).collect();
-    p.fit(cand, &train, &inner, &opts.lambdas)
+    p.fit(cand, &p.split(&train, &inner), &opts.lambdas)
 }
 
 fn fmt_num(x: f64) -> String {
@@ -465,15 +563,33 @@ fn fmt_num(x: f64) -> String {
 impl SelectionTable {
     /// The row of `cand` on `dataset`.
     pub fn row(&self, dataset: DatasetId, cand: Candidate) -> Option<&ScoreRow> {
-        self.rows.iter().find(|r| r.dataset == dataset && r.candidate == cand)
-    }
-
-    /// The winner on `dataset`: lowest median test MSE (ties: lowest mean).
-    pub fn best(&self, dataset: DatasetId) -> Option<&ScoreRow> {
         self.rows
             .iter()
-            .filter(|r| r.dataset == dataset)
-            .min_by(|a, b| a.median.total_cmp(&b.median).then(a.mean.total_cmp(&b.mean)))
+            .find(|r| r.dataset == dataset && r.candidate == cand)
+    }
+
+    /// The winner on `dataset`: lowest median test MSE. Medians equal to
+    /// within 1e-9 (relative) are ties, broken by the lower mean, then by
+    /// table order (simpler models come first), so rounding noise between
+    /// equivalent fits does not flip the choice.
+    pub fn best(&self, dataset: DatasetId) -> Option<&ScoreRow> {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+        let mut best: Option<&ScoreRow> = None;
+        for r in self.rows.iter().filter(|r| r.dataset == dataset) {
+            best = match best {
+                None => Some(r),
+                Some(b) if close(r.median, b.median) => {
+                    if r.mean < b.mean && !close(r.mean, b.mean) {
+                        Some(r)
+                    } else {
+                        Some(b)
+                    }
+                }
+                Some(b) if r.median < b.median => Some(r),
+                keep => keep,
+            };
+        }
+        best
     }
 
     fn datasets(&self) -> Vec<DatasetId> {
@@ -496,7 +612,12 @@ impl SelectionTable {
         let mut s = String::new();
         s.push_str("| Model | H |");
         for d in &ds {
-            let _ = write!(s, " {} MSE (μ ± σ) | {} MSE (median) |", d.as_str().to_uppercase(), d.as_str().to_uppercase());
+            let _ = write!(
+                s,
+                " {} MSE (μ ± σ) | {} MSE (median) |",
+                d.as_str().to_uppercase(),
+                d.as_str().to_uppercase()
+            );
         }
         s.push_str("\n|---|---|");
         for _ in &ds {
@@ -504,7 +625,12 @@ impl SelectionTable {
         }
         s.push('\n');
         for c in self.candidates() {
-            let _ = write!(s, "| {} | {} |", c.label(), c.history().map_or("-".into(), |h| h.to_string()));
+            let _ = write!(
+                s,
+                "| {} | {} |",
+                c.label(),
+                c.history().map_or("-".into(), |h| h.to_string())
+            );
             for &d in &ds {
                 match self.row(d, c) {
                     Some(r) => {
@@ -519,27 +645,48 @@ impl SelectionTable {
             s.push('\n');
         }
         s.push_str("\nPairs: ");
-        s.push_str(&self.n_pairs.iter().map(|(d, n)| format!("{} = {n}", d.as_str().to_uppercase())).collect::<Vec<_>>().join(", "));
+        s.push_str(
+            &self
+                .n_pairs
+                .iter()
+                .map(|(d, n)| format!("{} = {n}", d.as_str().to_uppercase()))
+                .collect::<Vec<_>>()
+                .join(", "),
+        );
         s.push_str(". Test MSE over outer folds; σ is the population standard deviation; predictions clamped to [0, 1].\n");
         s
     }
 
     /// One CSV line per (dataset, candidate).
     pub fn to_csv(&self) -> String {
-        let mut s = String::from("dataset,model,history,mean_mse,std_mse,median_mse,fold_mse,fold_lambda,selected\n");
+        let mut s = String::from(
+            "dataset,model,history,mean_mse,std_mse,median_mse,fold_mse,fold_lambda,selected\n",
+        );
         for r in &self.rows {
-            let sel = self.best(r.dataset).is_some_and(|b| b.candidate == r.candidate);
+            let sel = self
+                .best(r.dataset)
+                .is_some_and(|b| b.candidate == r.candidate);
             let _ = writeln!(
                 s,
                 "{},{},{},{},{},{},{},{},{}",
                 r.dataset.as_str(),
                 r.candidate.label(),
-                r.candidate.history().map_or(String::new(), |h| h.to_string()),
+                r.candidate
+                    .history()
+                    .map_or(String::new(), |h| h.to_string()),
                 r.mean,
                 r.std,
                 r.median,
-                r.fold_mse.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(";"),
-                r.fold_lambda.iter().map(|x| x.map_or(String::new(), |l| l.to_string())).collect::<Vec<_>>().join(";"),
+                r.fold_mse
+                    .iter()
+                    .map(|x| x.to_string())
+                    .collect::<Vec<_>>()
+                    .join(";"),
+                r.fold_lambda
+                    .iter()
+                    .map(|x| x.map_or(String::new(), |l| l.to_string()))
+                    .collect::<Vec<_>>()
+                    .join(";"),
                 sel
             );
         }

@@ -116,7 +116,11 @@ pub fn mann_whitney_u(x: &[f64], y: &[f64], alt: Alternative) -> Result<TestResu
                     continue;
                 }
                 for uu in 0..=m * n {
-                    let a = if uu >= n { table[m - 1][n][uu - n] } else { 0.0 };
+                    let a = if uu >= n {
+                        table[m - 1][n][uu - n]
+                    } else {
+                        0.0
+                    };
                     let b = table[m][n - 1].get(uu).copied().unwrap_or(0.0);
                     table[m][n][uu] = a + b;
                 }
@@ -127,7 +131,11 @@ pub fn mann_whitney_u(x: &[f64], y: &[f64], alt: Alternative) -> Result<TestResu
         let ui = u.round() as usize;
         let p_le = counts[..=ui].iter().sum::<f64>() / total;
         let p_ge = counts[ui..].iter().sum::<f64>() / total;
-        return Ok(TestResult { statistic: u, p_value: tail(alt, p_le, p_ge), exact: true });
+        return Ok(TestResult {
+            statistic: u,
+            p_value: tail(alt, p_le, p_ge),
+            exact: true,
+        });
     }
     let n = f1 + f2;
     let var = f1 * f2 / 12.0 * ((n + 1.0) - ties / (n * (n - 1.0)));
@@ -152,15 +160,31 @@ pub fn wilcoxon_signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<Te
     check("first sample", x)?;
     check("second sample", y)?;
     if x.len() != y.len() {
-        return Err(HilError::invalid_input("paired samples", format!("lengths differ: {} and {}", x.len(), y.len())));
+        return Err(HilError::invalid_input(
+            "paired samples",
+            format!("lengths differ: {} and {}", x.len(), y.len()),
+        ));
     }
-    let d: Vec<f64> = x.iter().zip(y).map(|(a, b)| a - b).filter(|d| *d != 0.0).collect();
+    let d: Vec<f64> = x
+        .iter()
+        .zip(y)
+        .map(|(a, b)| a - b)
+        .filter(|d| *d != 0.0)
+        .collect();
     if d.is_empty() {
-        return Err(HilError::invalid_input("paired samples", "all differences are zero"));
+        return Err(HilError::invalid_input(
+            "paired samples",
+            "all differences are zero",
+        ));
     }
     let abs: Vec<f64> = d.iter().map(|v| v.abs()).collect();
     let (ranks, ties) = midranks(&abs);
-    let w_plus: f64 = ranks.iter().zip(&d).filter(|(_, d)| **d > 0.0).map(|(r, _)| r).sum();
+    let w_plus: f64 = ranks
+        .iter()
+        .zip(&d)
+        .filter(|(_, d)| **d > 0.0)
+        .map(|(r, _)| r)
+        .sum();
     let n = d.len();
     if ties == 0.0 && n <= EXACT_LIMIT {
         let max = n * (n + 1) / 2;
@@ -175,7 +199,11 @@ pub fn wilcoxon_signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<Te
         let wi = w_plus.round() as usize;
         let p_le = counts[..=wi].iter().sum::<f64>() / total;
         let p_ge = counts[wi..].iter().sum::<f64>() / total;
-        return Ok(TestResult { statistic: w_plus, p_value: tail(alt, p_le, p_ge), exact: true });
+        return Ok(TestResult {
+            statistic: w_plus,
+            p_value: tail(alt, p_le, p_ge),
+            exact: true,
+        });
     }
     let f = n as f64;
     let mean = f * (f + 1.0) / 4.0;
@@ -195,10 +223,20 @@ mod tests {
     fn mann_whitney_textbook_values() {
         // Exact: U = 3 for n1 = n2 = 4 has P(U ≤ 3) = 7/70 = 0.1
         // (counts of U = 0, 1, 2, 3 are 1, 1, 2, 3).
-        let r = mann_whitney_u(&[1.0, 2.0, 3.0, 7.5], &[4.0, 5.0, 6.0, 8.0], Alternative::Less).unwrap();
+        let r = mann_whitney_u(
+            &[1.0, 2.0, 3.0, 7.5],
+            &[4.0, 5.0, 6.0, 8.0],
+            Alternative::Less,
+        )
+        .unwrap();
         assert_eq!(r.statistic, 3.0);
         assert!((r.p_value - 0.1).abs() < 1e-12, "{r:?}");
-        let g = mann_whitney_u(&[1.0, 2.0, 3.0, 7.5], &[4.0, 5.0, 6.0, 8.0], Alternative::Greater).unwrap();
+        let g = mann_whitney_u(
+            &[1.0, 2.0, 3.0, 7.5],
+            &[4.0, 5.0, 6.0, 8.0],
+            Alternative::Greater,
+        )
+        .unwrap();
         assert!((g.p_value - (1.0 - 4.0 / 70.0)).abs() < 1e-12, "{g:?}");
         // Large sample with ties: normal approximation, z from first principles.
         let x: Vec<f64> = (0..60).map(|i| (i % 5) as f64).collect();
@@ -217,13 +255,18 @@ mod tests {
         assert_eq!(r.statistic, 1.0);
         assert!((r.p_value - 2.0 / 32.0).abs() < 1e-12, "{r:?}");
         // Exact and normal approximations agree closely for n = 30.
-        let d: Vec<f64> = (1..=30).map(|i| if i % 3 == 0 { -(i as f64) } else { i as f64 }).collect();
+        let d: Vec<f64> = (1..=30)
+            .map(|i| if i % 3 == 0 { -(i as f64) } else { i as f64 })
+            .collect();
         let exact = wilcoxon_signed_rank(&d, &[0.0; 30], Alternative::Greater).unwrap();
         let mut tied = d.clone();
         tied.push(1.0); // a tie forces the approximation
         let approx = wilcoxon_signed_rank(&tied, &[0.0; 31], Alternative::Greater).unwrap();
         assert!(exact.exact && !approx.exact);
-        assert!((exact.p_value - approx.p_value).abs() < 0.02, "{exact:?} {approx:?}");
+        assert!(
+            (exact.p_value - approx.p_value).abs() < 0.02,
+            "{exact:?} {approx:?}"
+        );
         assert!(wilcoxon_signed_rank(&[1.0], &[1.0], Alternative::Less).is_err());
     }
 }

@@ -142,7 +142,12 @@ pub struct Study {
     records: Vec<StudyRecord>,
 }
 
-fn data_err(path: &Path, line: usize, field: impl Into<String>, why: impl Into<String>) -> HilError {
+fn data_err(
+    path: &Path,
+    line: usize,
+    field: impl Into<String>,
+    why: impl Into<String>,
+) -> HilError {
     HilError::Data {
         path: path.to_path_buf(),
         record: line,
@@ -171,20 +176,34 @@ impl Study {
 
     /// Parses and validates study CSV text; `path` names it in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
         let Some((header_idx, header)) = lines.next() else {
-            return Err(data_err(path, 1, "header", "the file is empty: expected a header row"));
+            return Err(data_err(
+                path,
+                1,
+                "header",
+                "the file is empty: expected a header row",
+            ));
         };
         let header_line = header_idx + 1;
         let mut index: HashMap<&str, usize> = HashMap::new();
-        let names: Vec<&str> = header.split(',').map(|c| c.trim().trim_start_matches('\u{feff}')).collect();
+        let names: Vec<&str> = header
+            .split(',')
+            .map(|c| c.trim().trim_start_matches('\u{feff}'))
+            .collect();
         for (i, name) in names.iter().enumerate() {
             if !COLUMNS.contains(name) {
                 return Err(data_err(
                     path,
                     header_line,
                     format!("column {} (`{name}`)", i + 1),
-                    format!("unknown column; expected the columns {}", COLUMNS.join(", ")),
+                    format!(
+                        "unknown column; expected the columns {}",
+                        COLUMNS.join(", ")
+                    ),
                 ));
             }
             if index.insert(name, i).is_some() {
@@ -209,7 +228,11 @@ impl Study {
                     path,
                     line,
                     "row",
-                    format!("{} cells, but the header has {} columns", cells.len(), names.len()),
+                    format!(
+                        "{} cells, but the header has {} columns",
+                        cells.len(),
+                        names.len()
+                    ),
                 ));
             }
             let cell = |name: &str| -> (&str, String) {
@@ -229,27 +252,43 @@ impl Study {
                 if v.is_empty() {
                     return Ok(None);
                 }
-                allowed.iter().position(|a| *a == v).map(Some).ok_or_else(|| {
-                    data_err(
-                        path,
-                        line,
-                        f,
-                        format!("unknown value `{v}`; expected one of {}", allowed.join(", ")),
-                    )
-                })
+                allowed
+                    .iter()
+                    .position(|a| *a == v)
+                    .map(Some)
+                    .ok_or_else(|| {
+                        data_err(
+                            path,
+                            line,
+                            f,
+                            format!(
+                                "unknown value `{v}`; expected one of {}",
+                                allowed.join(", ")
+                            ),
+                        )
+                    })
             };
             let seconds = |name: &str, v: &str, f: &str| -> Result<f64> {
                 let x: f64 = v
                     .parse()
                     .map_err(|_| data_err(path, line, f, format!("`{v}` is not a number")))?;
                 if !x.is_finite() || x < 0.0 {
-                    return Err(data_err(path, line, f, format!("{name} must be a finite number ≥ 0, got {v}")));
+                    return Err(data_err(
+                        path,
+                        line,
+                        f,
+                        format!("{name} must be a finite number ≥ 0, got {v}"),
+                    ));
                 }
                 Ok(x)
             };
             let (participant, _) = req("participant")?;
             let (condition, _) = req("condition")?;
-            let pops = ["no_limitation", "mobility_limitation", "occupational_therapist"];
+            let pops = [
+                "no_limitation",
+                "mobility_limitation",
+                "occupational_therapist",
+            ];
             req("population")?;
             let population = [
                 Population::NoLimitation,
@@ -259,7 +298,8 @@ impl Study {
             let (t, tf) = req("query_time_s")?;
             let query_time_s = seconds("a time", t, &tf)?;
             req("distraction")?;
-            let distraction = Distraction::ALL[enum_of("distraction", &["none", "easy", "hard"])?.unwrap_or(0)];
+            let distraction =
+                Distraction::ALL[enum_of("distraction", &["none", "easy", "hard"])?.unwrap_or(0)];
             let difficulty = enum_of("difficulty", &["easy", "hard"])?.map(|i| Difficulty::ALL[i]);
             let response = enum_of("response_type", &["mcq", "bounding_box", "open_ended"])?
                 .map(|i| ResponseType::ALL[i]);
@@ -272,11 +312,15 @@ impl Study {
                 }),
                 (None, None, None) => None,
                 _ => {
-                    let missing = [("difficulty", difficulty.is_none()), ("response_type", response.is_none()), ("interval_min", interval.is_none())]
-                        .into_iter()
-                        .find(|(_, m)| *m)
-                        .map(|(n, _)| n)
-                        .unwrap_or("difficulty");
+                    let missing = [
+                        ("difficulty", difficulty.is_none()),
+                        ("response_type", response.is_none()),
+                        ("interval_min", interval.is_none()),
+                    ]
+                    .into_iter()
+                    .find(|(_, m)| *m)
+                    .map(|(n, _)| n)
+                    .unwrap_or("difficulty");
                     return Err(data_err(
                         path,
                         line,
@@ -286,17 +330,31 @@ impl Study {
                 }
             };
             let mut likert = [0u8; 5];
-            for (k, name) in ["mental", "temporal", "performance", "effort", "frustration"].iter().enumerate() {
+            for (k, name) in ["mental", "temporal", "performance", "effort", "frustration"]
+                .iter()
+                .enumerate()
+            {
                 let (v, f) = req(name)?;
                 likert[k] = v
                     .parse::<u8>()
                     .ok()
                     .filter(|a| (1..=5).contains(a))
-                    .ok_or_else(|| data_err(path, line, f, format!("`{v}` is not a Likert answer: expected an integer in 1..=5")))?;
+                    .ok_or_else(|| {
+                        data_err(
+                            path,
+                            line,
+                            f,
+                            format!("`{v}` is not a Likert answer: expected an integer in 1..=5"),
+                        )
+                    })?;
             }
             let tlx = TlxAnswers::new(likert[0], likert[1], likert[2], likert[3], likert[4])?;
             let (st, stf) = cell("survey_time_s");
-            let survey_time_s = if st.is_empty() { None } else { Some(seconds("a survey time", st, &stf)?) };
+            let survey_time_s = if st.is_empty() {
+                None
+            } else {
+                Some(seconds("a survey time", st, &stf)?)
+            };
             records.push(StudyRecord {
                 participant: participant.to_string(),
                 population,
@@ -330,26 +388,57 @@ impl Study {
         for (i, r) in self.records.iter().enumerate() {
             let line = if r.line > 0 { r.line } else { i + 2 };
             if r.participant.is_empty() || r.participant.contains(',') {
-                return Err(data_err(path, line, "participant", "must be non-empty and contain no comma"));
+                return Err(data_err(
+                    path,
+                    line,
+                    "participant",
+                    "must be non-empty and contain no comma",
+                ));
             }
             if r.condition.is_empty() || r.condition.contains(',') {
-                return Err(data_err(path, line, "condition", "must be non-empty and contain no comma"));
+                return Err(data_err(
+                    path,
+                    line,
+                    "condition",
+                    "must be non-empty and contain no comma",
+                ));
             }
             if !(r.query_time_s.is_finite() && r.query_time_s >= 0.0) {
-                return Err(data_err(path, line, "query_time_s", format!("must be finite and ≥ 0, got {}", r.query_time_s)));
+                return Err(data_err(
+                    path,
+                    line,
+                    "query_time_s",
+                    format!("must be finite and ≥ 0, got {}", r.query_time_s),
+                ));
             }
             if let Some(s) = r.survey_time_s
                 && !(s.is_finite() && s >= 0.0)
             {
-                return Err(data_err(path, line, "survey_time_s", format!("must be finite and ≥ 0, got {s}")));
+                return Err(data_err(
+                    path,
+                    line,
+                    "survey_time_s",
+                    format!("must be finite and ≥ 0, got {s}"),
+                ));
             }
             if let Some(q) = r.query
                 && !(1..=2).contains(&q.interval_min)
             {
-                return Err(data_err(path, line, "interval_min", format!("must be 1 or 2, got {}", q.interval_min)));
+                return Err(data_err(
+                    path,
+                    line,
+                    "interval_min",
+                    format!("must be 1 or 2, got {}", q.interval_min),
+                ));
             }
-            TlxAnswers::new(r.tlx.mental, r.tlx.temporal, r.tlx.performance, r.tlx.effort, r.tlx.frustration)
-                .map_err(|e| data_err(path, line, "tlx", e.to_string()))?;
+            TlxAnswers::new(
+                r.tlx.mental,
+                r.tlx.temporal,
+                r.tlx.performance,
+                r.tlx.effort,
+                r.tlx.frustration,
+            )
+            .map_err(|e| data_err(path, line, "tlx", e.to_string()))?;
             if let Some(p) = pop.insert(&r.participant, r.population)
                 && p != r.population
             {
@@ -357,7 +446,12 @@ impl Study {
                     path,
                     line,
                     "population",
-                    format!("participant `{}` was `{}` on an earlier row, `{}` here", r.participant, p.as_str(), r.population.as_str()),
+                    format!(
+                        "participant `{}` was `{}` on an earlier row, `{}` here",
+                        r.participant,
+                        p.as_str(),
+                        r.population.as_str()
+                    ),
                 ));
             }
             if let Some(d) = dist.insert((&r.participant, &r.condition), r.distraction)
@@ -367,7 +461,10 @@ impl Study {
                     path,
                     line,
                     "distraction",
-                    format!("condition `{}` of participant `{}` has two distraction settings", r.condition, r.participant),
+                    format!(
+                        "condition `{}` of participant `{}` has two distraction settings",
+                        r.condition, r.participant
+                    ),
                 ));
             }
             if !seen.insert((&r.participant, &r.condition, r.query_time_s.to_bits())) {
@@ -459,9 +556,15 @@ mod tests {
     #[test]
     fn bad_inputs_name_file_line_and_column() {
         let e = err("p1,no_limitation,c1,60,easy,mcq,none,1,1,2,3,4,6,\n");
-        assert!(e.contains("s.csv:2") && e.contains("column 13 (`frustration`)"), "{e}");
+        assert!(
+            e.contains("s.csv:2") && e.contains("column 13 (`frustration`)"),
+            "{e}"
+        );
         let e = err("p1,no_limitation,c1,60,medium,mcq,none,1,1,2,3,4,5,\n");
-        assert!(e.contains("s.csv:2") && e.contains("`difficulty`") && e.contains("medium"), "{e}");
+        assert!(
+            e.contains("s.csv:2") && e.contains("`difficulty`") && e.contains("medium"),
+            "{e}"
+        );
         let e = err("p1,no_limitation,c1,-3,easy,mcq,none,1,1,2,3,4,5,\n");
         assert!(e.contains("query_time_s") && e.contains("≥ 0"), "{e}");
         let e = err("p1,no_limitation,c1,3,easy,mcq,none,1,1,2,3,4,5,-1\n");
@@ -472,14 +575,25 @@ mod tests {
         assert!(e.contains("population") && e.contains("martian"), "{e}");
         let e = err("");
         assert!(e.contains("no records"), "{e}");
-        let e = Study::parse("participant,population\n", Path::new("s.csv")).unwrap_err().to_string();
+        let e = Study::parse("participant,population\n", Path::new("s.csv"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("missing column"), "{e}");
         let dup = HEADER.replace("frustration", "mental");
-        let e = Study::parse(&format!("{dup}\n"), Path::new("s.csv")).unwrap_err().to_string();
-        assert!(e.contains("duplicated column") && e.contains("column 13"), "{e}");
-        let e = err("p1,no_limitation,c1,3,easy,mcq,none,1,1,2,3,4,5,\np1,no_limitation,c1,3,easy,mcq,none,1,1,2,3,4,5,\n");
+        let e = Study::parse(&format!("{dup}\n"), Path::new("s.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("duplicated column") && e.contains("column 13"),
+            "{e}"
+        );
+        let e = err(
+            "p1,no_limitation,c1,3,easy,mcq,none,1,1,2,3,4,5,\np1,no_limitation,c1,3,easy,mcq,none,1,1,2,3,4,5,\n",
+        );
         assert!(e.contains("s.csv:3") && e.contains("duplicate"), "{e}");
-        let e = Study::parse("", Path::new("s.csv")).unwrap_err().to_string();
+        let e = Study::parse("", Path::new("s.csv"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("empty"), "{e}");
     }
 }

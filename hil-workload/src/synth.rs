@@ -21,9 +21,9 @@
 //! [`SynthParams`] holds the calibrated values; see the crate README for
 //! the figures they reproduce.
 
-use hil_core::{Difficulty, Distraction, Result, ResponseType};
-use rand::{Rng, SeedableRng};
+use hil_core::{Difficulty, Distraction, ResponseType, Result};
 use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, LogNormal, Normal};
 use serde::{Deserialize, Serialize};
@@ -64,6 +64,10 @@ pub struct SynthParams {
     pub survey_sd: f64,
     /// Per-subscale standard deviation.
     pub item_sd: f64,
+    /// Extra baseline (WL_0) level of people with limitations.
+    pub limited_baseline_shift: f64,
+    /// Per-survey standard deviation of people with limitations.
+    pub limited_survey_sd: f64,
 }
 
 impl Default for SynthParams {
@@ -83,6 +87,8 @@ impl Default for SynthParams {
             condition_sd: 0.06,
             survey_sd: 0.13,
             item_sd: 0.1,
+            limited_baseline_shift: 0.22,
+            limited_survey_sd: 0.22,
         }
     }
 }
@@ -151,11 +157,18 @@ impl SynthConfig {
         let p = &self.params;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let std_normal = Normal::new(0.0, 1.0).expect("valid");
-        let survey_time = LogNormal::new(self.survey_time_median_s.max(1e-3).ln(), 0.4).expect("valid");
+        let survey_time =
+            LogNormal::new(self.survey_time_median_s.max(1e-3).ln(), 0.4).expect("valid");
         let mut records = Vec::new();
         let pops = std::iter::repeat_n(Population::NoLimitation, self.n_no_limitation)
-            .chain(std::iter::repeat_n(Population::MobilityLimitation, self.n_mobility_limitation))
-            .chain(std::iter::repeat_n(Population::OccupationalTherapist, self.n_occupational_therapist));
+            .chain(std::iter::repeat_n(
+                Population::MobilityLimitation,
+                self.n_mobility_limitation,
+            ))
+            .chain(std::iter::repeat_n(
+                Population::OccupationalTherapist,
+                self.n_occupational_therapist,
+            ));
         let mut limited_seen = 0;
         let mut d2_query_rows: Vec<usize> = Vec::new();
         for (pi, pop) in pops.enumerate() {
@@ -166,8 +179,23 @@ impl SynthConfig {
             };
             let mut z = || std_normal.sample(&mut rng);
             let level = p.participant_sd * z();
-            let shift = if pop.is_limited() { p.population_shift } else { 0.0 };
-            let base_level = p.mean + shift + p.baseline_offset + p.baseline_share * level + p.baseline_sd * z();
+            let shift = if pop.is_limited() {
+                p.population_shift
+            } else {
+                0.0
+            };
+            // people with limitations: a higher resting level and noisier answers
+            let (base_shift, survey_sd) = if pop.is_limited() {
+                (p.limited_baseline_shift, p.limited_survey_sd)
+            } else {
+                (0.0, p.survey_sd)
+            };
+            let base_level = p.mean
+                + shift
+                + base_shift
+                + p.baseline_offset
+                + p.baseline_share * level
+                + p.baseline_sd * z();
             let survey = |rng: &mut ChaCha8Rng, latent: f64| -> (TlxAnswers, Option<f64>) {
                 let mut item = |off: f64| -> u8 {
                     let v = (latent + off + p.item_sd * std_normal.sample(rng)).clamp(0.0, 1.0);
@@ -176,12 +204,18 @@ impl SynthConfig {
                 let (m, t, e) = (item(0.0), item(-0.03), item(0.02));
                 let perf = item(-0.2).max(1);
                 let frus = item(-0.15);
-                let tlx = TlxAnswers::new(m, t, 6 - perf, e, frus).expect("answers in 1..=5 by construction");
+                let tlx = TlxAnswers::new(m, t, 6 - perf, e, frus)
+                    .expect("answers in 1..=5 by construction");
                 let st = logged.then(|| (survey_time.sample(rng) * 10.0).round() / 10.0);
                 (tlx, st)
             };
-            for (bi, dist) in [Distraction::Easy, Distraction::Hard].into_iter().enumerate() {
-                let latent = base_level + p.distraction[dist as usize] + p.survey_sd * std_normal.sample(&mut rng);
+            for (bi, dist) in [Distraction::Easy, Distraction::Hard]
+                .into_iter()
+                .enumerate()
+            {
+                let latent = base_level
+                    + p.distraction[dist as usize]
+                    + survey_sd * std_normal.sample(&mut rng);
                 let (tlx, st) = survey(&mut rng, latent);
                 records.push(StudyRecord {
                     participant: id.clone(),
@@ -205,7 +239,10 @@ impl SynthConfig {
                         let start = rng.random_range(0..3usize);
                         for (k, &tau) in times.iter().enumerate() {
                             let response = ResponseType::ALL[(start + k) % 3];
-                            let carry: f64 = times[..k].iter().map(|&s| p.carry * (-(tau - s) / p.carry_tau_s).exp()).sum();
+                            let carry: f64 = times[..k]
+                                .iter()
+                                .map(|&s| p.carry * (-(tau - s) / p.carry_tau_s).exp())
+                                .sum();
                             let latent = p.mean
                                 + shift
                                 + level
@@ -214,7 +251,7 @@ impl SynthConfig {
                                 + p.response[response as usize]
                                 + p.distraction[distraction as usize]
                                 + carry
-                                + p.survey_sd * std_normal.sample(&mut rng);
+                                + survey_sd * std_normal.sample(&mut rng);
                             let (tlx, st) = survey(&mut rng, latent);
                             if pop.is_limited() {
                                 d2_query_rows.push(records.len());

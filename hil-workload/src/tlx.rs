@@ -58,7 +58,13 @@ pub fn check_likert(name: &str, answer: u8) -> Result<u8> {
 
 impl TlxAnswers {
     /// Builds a survey, checking every answer is in 1..=5.
-    pub fn new(mental: u8, temporal: u8, performance: u8, effort: u8, frustration: u8) -> Result<Self> {
+    pub fn new(
+        mental: u8,
+        temporal: u8,
+        performance: u8,
+        effort: u8,
+        frustration: u8,
+    ) -> Result<Self> {
         Ok(Self {
             mental: check_likert("mental", mental)?,
             temporal: check_likert("temporal", temporal)?,

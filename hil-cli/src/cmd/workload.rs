@@ -39,6 +39,12 @@ enum WorkloadCommand {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Print a study's headline figures (pairs, WL mean ± sd, Mann-Whitney D1 < D2).
+    Summary {
+        /// Study CSV.
+        #[arg(long)]
+        data: PathBuf,
+    },
     /// Cross-validate every model on D1, D2, D12 and write the selection table.
     Select {
         /// Study CSV.
@@ -168,6 +174,12 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 print!("{}", StudySummary::of(&study)?.to_text());
                 println!("{SYNTHETIC}");
             }
+            Ok(())
+        }
+        WorkloadCommand::Summary { data } => {
+            let study = Study::load(&data)?;
+            println!("{}: {} surveys", data.display(), study.records().len());
+            print!("{}", StudySummary::of(&study)?.to_text());
             Ok(())
         }
         WorkloadCommand::Select {

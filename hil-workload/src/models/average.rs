@@ -24,7 +24,10 @@ impl AverageModel {
     /// Fits the mean WL_0 of `pairs`.
     pub fn fit(pairs: &[&TrainingPair]) -> Result<Self> {
         if pairs.is_empty() {
-            return Err(HilError::invalid_input("training set", "no pairs to average"));
+            return Err(HilError::invalid_input(
+                "training set",
+                "no pairs to average",
+            ));
         }
         Ok(Self {
             value: pairs.iter().map(|p| p.wl0).sum::<f64>() / pairs.len() as f64,
@@ -33,7 +36,8 @@ impl AverageModel {
 
     /// Checks the value is a workload in [0, 1].
     pub fn validate(&self) -> Result<()> {
-        check_wl0(self.value).map_err(|_| HilError::invalid_parameter("value", self.value, "must be in [0, 1]"))
+        check_wl0(self.value)
+            .map_err(|_| HilError::invalid_parameter("value", self.value, "must be in [0, 1]"))
     }
 }
 

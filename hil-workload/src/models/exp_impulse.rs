@@ -7,9 +7,9 @@ use hil_core::{HilError, QueryHistory, Result, Timestep, WorkloadModel, workload
 use serde::{Deserialize, Serialize};
 
 use crate::datasets::TrainingPair;
+use crate::features::SparseRow;
 use crate::features::{KIND_FEATURES, one_hot_indices};
 use crate::fit::{BoxLsq, Gram};
-use crate::features::SparseRow;
 
 /// A fitted Exp-Impulse model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -26,7 +26,11 @@ impl ExpImpulseModel {
     /// Checks λ ≥ 0 and all values finite.
     pub fn validate(&self) -> Result<()> {
         if !(self.decay.is_finite() && self.decay >= 0.0) {
-            return Err(HilError::invalid_parameter("decay", self.decay, "must be finite and ≥ 0"));
+            return Err(HilError::invalid_parameter(
+                "decay",
+                self.decay,
+                "must be finite and ≥ 0",
+            ));
         }
         if let Some(b) = self.impulse.iter().find(|b| !b.is_finite()) {
             return Err(HilError::invalid_parameter("impulse", b, "must be finite"));
@@ -39,7 +43,11 @@ impl ExpImpulseModel {
         let mut wl = wl0;
         let mut prev: Timestep = 0;
         for r in history.records().iter().filter(|r| r.t <= t) {
-            wl = wl * (-self.decay * (r.t - prev) as f64).exp() + one_hot_indices(&r.kind).iter().map(|&j| self.impulse[j]).sum::<f64>();
+            wl = wl * (-self.decay * (r.t - prev) as f64).exp()
+                + one_hot_indices(&r.kind)
+                    .iter()
+                    .map(|&j| self.impulse[j])
+                    .sum::<f64>();
             prev = r.t;
         }
         wl * (-self.decay * (t - prev) as f64).exp()
@@ -58,21 +66,31 @@ impl ExpImpulseModel {
             for (row, _) in &rows {
                 g.add_row(row);
             }
-            let beta = BoxLsq::plain(&g).solve(None).unwrap_or_else(|_| vec![0.0; KIND_FEATURES]);
+            let beta = BoxLsq::plain(&g)
+                .solve(None)
+                .unwrap_or_else(|_| vec![0.0; KIND_FEATURES]);
             let mut b = [0.0; KIND_FEATURES];
             b.copy_from_slice(&beta);
-            let sse: f64 = rows.iter().map(|(r, _)| (r.dot_prefix(&beta) - r.y).powi(2)).sum();
+            let sse: f64 = rows
+                .iter()
+                .map(|(r, _)| (r.dot_prefix(&beta) - r.y).powi(2))
+                .sum();
             (sse, b)
         };
         // coarse grid over λ in [1e-4, 10] per timestep
         let (lo, hi) = ((1e-4f64).ln(), (10.0f64).ln());
         let n = 24;
-        let grid: Vec<f64> = (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect();
-        let (best_i, _) = grid
-            .iter()
-            .map(|&x| sse(x).0)
-            .enumerate()
-            .fold((0, f64::INFINITY), |acc, (i, s)| if s < acc.1 { (i, s) } else { acc });
+        let grid: Vec<f64> = (0..=n)
+            .map(|i| lo + (hi - lo) * i as f64 / n as f64)
+            .collect();
+        let (best_i, _) =
+            grid.iter()
+                .map(|&x| sse(x).0)
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |acc, (i, s)| if s < acc.1 { (i, s) } else { acc },
+                );
         let mut a = grid[best_i.saturating_sub(1)];
         let mut b = grid[(best_i + 1).min(n)];
         let phi = (5f64.sqrt() - 1.0) / 2.0;
@@ -90,10 +108,13 @@ impl ExpImpulseModel {
         let best = cands
             .iter()
             .map(|&x| (x, sse(x)))
-            .fold(None::<(f64, (f64, [f64; KIND_FEATURES]))>, |acc, c| match acc {
-                Some(a) if a.1.0 <= c.1.0 => Some(a),
-                _ => Some(c),
-            })
+            .fold(
+                None::<(f64, (f64, [f64; KIND_FEATURES]))>,
+                |acc, c| match acc {
+                    Some(a) if a.1.0 <= c.1.0 => Some(a),
+                    _ => Some(c),
+                },
+            )
             .expect("two candidates");
         let m = Self {
             decay: best.0.exp(),

@@ -32,7 +32,12 @@ pub enum GrangerVariant {
 
 impl GrangerVariant {
     /// The four cross-validated variants, in table order.
-    pub const TABLE: [Self; 4] = [Self::Plain, Self::Nonnegative, Self::Ridge, Self::RidgeNonnegative];
+    pub const TABLE: [Self; 4] = [
+        Self::Plain,
+        Self::Nonnegative,
+        Self::Ridge,
+        Self::RidgeNonnegative,
+    ];
 
     /// Label used in tables (`Granger`, `Granger-N`, ...).
     pub fn label(self) -> &'static str {
@@ -63,7 +68,10 @@ impl GrangerVariant {
 
     /// True if every query's effect is constrained to be non-negative.
     pub fn is_monotone(self) -> bool {
-        matches!(self, Self::Nonnegative | Self::RidgeNonnegative | Self::Simulation)
+        matches!(
+            self,
+            Self::Nonnegative | Self::RidgeNonnegative | Self::Simulation
+        )
     }
 
     /// Coefficient bounds for design columns `[WL_0, 1, lags…]` of history h.
@@ -116,14 +124,24 @@ pub struct GrangerModel {
 
 impl GrangerModel {
     /// Builds a model from design coefficients `[γ, w_0, lags…]`.
-    pub fn from_coefficients(variant: GrangerVariant, h: usize, w: &[f64], ridge_lambda: Option<f64>) -> Result<Self> {
+    pub fn from_coefficients(
+        variant: GrangerVariant,
+        h: usize,
+        w: &[f64],
+        ridge_lambda: Option<f64>,
+    ) -> Result<Self> {
         if w.len() != n_columns(h) {
-            return Err(HilError::invalid_input("coefficients", format!("{} values for H = {h} (expected {})", w.len(), n_columns(h))));
+            return Err(HilError::invalid_input(
+                "coefficients",
+                format!("{} values for H = {h} (expected {})", w.len(), n_columns(h)),
+            ));
         }
         let weights = (0..h)
             .map(|i| {
                 let mut a = [0.0; KIND_FEATURES];
-                a.copy_from_slice(&w[LEAD_COLUMNS + i * KIND_FEATURES..LEAD_COLUMNS + (i + 1) * KIND_FEATURES]);
+                a.copy_from_slice(
+                    &w[LEAD_COLUMNS + i * KIND_FEATURES..LEAD_COLUMNS + (i + 1) * KIND_FEATURES],
+                );
                 a
             })
             .collect();
@@ -154,20 +172,32 @@ impl GrangerModel {
             return Err(HilError::invalid_parameter(
                 "history",
                 self.history,
-                format!("must be ≥ 1 and match the {} weight rows", self.weights.len()),
+                format!(
+                    "must be ≥ 1 and match the {} weight rows",
+                    self.weights.len()
+                ),
             ));
         }
         let (lower, upper) = self.variant.bounds(self.history);
         for (i, c) in self.coefficients().iter().enumerate() {
             if !c.is_finite() {
-                return Err(HilError::invalid_parameter("coefficients", c, format!("coefficient {i} is not finite")));
+                return Err(HilError::invalid_parameter(
+                    "coefficients",
+                    c,
+                    format!("coefficient {i} is not finite"),
+                ));
             }
             // allow rounding slack from the solver
             if *c < lower[i] - 1e-9 || *c > upper[i] + 1e-9 {
                 return Err(HilError::invalid_parameter(
                     "coefficients",
                     c,
-                    format!("coefficient {i} is outside [{}, {}] required by {}", lower[i], upper[i], self.variant.label()),
+                    format!(
+                        "coefficient {i} is outside [{}, {}] required by {}",
+                        lower[i],
+                        upper[i],
+                        self.variant.label()
+                    ),
                 ));
             }
         }

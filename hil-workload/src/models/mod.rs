@@ -159,7 +159,9 @@ impl FittedModel {
                 return Err(err(
                     line_of("format"),
                     "format",
-                    format!("expected \"{FORMAT}\", found {other:?}: not a hil workload model file"),
+                    format!(
+                        "expected \"{FORMAT}\", found {other:?}: not a hil workload model file"
+                    ),
                 ));
             }
         }
@@ -169,15 +171,24 @@ impl FittedModel {
                 return Err(err(
                     line_of("format_version"),
                     "format_version",
-                    format!("the file has format version {v}; this build reads version {FORMAT_VERSION} only (refit or convert the model)"),
+                    format!(
+                        "the file has format version {v}; this build reads version {FORMAT_VERSION} only (refit or convert the model)"
+                    ),
                 ));
             }
             None => {
-                return Err(err(line_of("format_version"), "format_version", "missing or not an unsigned integer".into()));
+                return Err(err(
+                    line_of("format_version"),
+                    "format_version",
+                    "missing or not an unsigned integer".into(),
+                ));
             }
         }
-        let m: Self = serde_json::from_str(text).map_err(|e| err(e.line(), "spec", e.to_string()))?;
-        m.spec.validate().map_err(|e| err(line_of("spec"), "spec", e.to_string()))?;
+        let m: Self =
+            serde_json::from_str(text).map_err(|e| err(e.line(), "spec", e.to_string()))?;
+        m.spec
+            .validate()
+            .map_err(|e| err(line_of("spec"), "spec", e.to_string()))?;
         Ok(m)
     }
 

@@ -267,7 +267,7 @@ impl FoodModel {
                 cut_fraction: 0.3,
                 grip_per_m: (1.2, 0.5),
                 friction: (1.0, 0.3),
-                tear_per_m: (40.0, 0.3),
+                tear_per_m: (120.0, 0.3),
             },
             FoodKind::Carrot => FoodModel {
                 kind,

@@ -229,6 +229,15 @@ impl Simulator {
                 self.apply_props(kind, p);
             }
         }
+        // Recompute the model constants that depend on masses and inertias
+        // (constraint scaling uses them).
+        // SAFETY: model and data belong together; mj_setConst only writes
+        // constant fields of the model and scratch fields of the data.
+        unsafe {
+            let d: *mut mujoco_rs::mujoco_c::mjData = self.data.ffi_mut();
+            let m: *mut mujoco_rs::mujoco_c::mjModel = self.data.model_mut().ffi_mut();
+            mujoco_rs::mujoco_c::mj_setConst(m, d);
+        }
         self.data.reset();
         {
             let home = self.home;
@@ -281,7 +290,16 @@ impl Simulator {
         };
         // Items weigh grams and their rotational inertia is tiny; a floor
         // keeps their contacts with the plate numerically stable at 1 ms.
-        let inertia = p.shape.inertia(p.mass).map(|i| i.max(MIN_INERTIA));
+        let body_frame = p.shape.inertia(p.mass).map(|i| i.max(MIN_INERTIA));
+        // MuJoCo stores inertia in the body's inertial frame (body_iquat),
+        // which the compiler aligned with the geom; it may also place the
+        // geom in that frame, so the frame stays and the diagonal is
+        // expressed in it (the shapes are symmetric: a permutation).
+        let iq = self.data.model().body_iquat()[f.body];
+        let r = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(iq[0], iq[1], iq[2], iq[3]))
+            .to_rotation_matrix();
+        let inertial = r.matrix().transpose() * Matrix3::from_diagonal(&Vector3::from(body_frame)) * r.matrix();
+        let inertia = [inertial[(0, 0)], inertial[(1, 1)], inertial[(2, 2)]];
         // SAFETY: only sizes, masses and inertias of existing elements change;
         // no count, address or array size of the model is touched.
         let m = unsafe { self.data.model_mut() };
@@ -290,8 +308,6 @@ impl Simulator {
         m.geom_rbound_mut()[f.geom] = p.shape.bounding_radius();
         m.body_mass_mut()[f.body] = p.mass;
         m.body_inertia_mut()[f.body] = inertia;
-        m.body_ipos_mut()[f.body] = [0.0; 3];
-        m.body_iquat_mut()[f.body] = [1.0, 0.0, 0.0, 0.0];
     }
 
     /// True poses of the items on the plate.
@@ -355,6 +371,10 @@ impl Simulator {
             xfrc[self.ids.food[k].body] = wrench6(w);
         }
         xfrc[self.ids.fork_body] = wrench6(&on_fork);
+        if std::env::var("HIL_DEBUG3").is_ok() && (self.data.time() * 1000.0).round() as u64 % 50 == 0 {
+            let b = self.ids.food[0].body;
+            eprintln!("t={:.3} banana z={:.4} f={:?} fork={:?} tines={:?}", self.data.time(), self.data.xpos()[b][2], on_food[0].force, on_fork.force, skewer.tines().iter().map(|t| match t { crate::skewer::TineState::Free => 'F', crate::skewer::TineState::Indenting{..} => 'I', crate::skewer::TineState::Pierced{..} => 'P', crate::skewer::TineState::Torn => 'T'}).collect::<String>());
+        }
         let t0 = Instant::now();
         self.data.step();
         self.timing.in_step += t0.elapsed();

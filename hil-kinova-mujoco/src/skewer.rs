@@ -237,9 +237,7 @@ impl SkewerModel {
                     .indent_stiffness
                     .min(stable_stiffness(props.mass, self.dt));
                 let normal = k * d.max(0.0);
-                if props.indent_stiffness * d.max(0.0) >= props.puncture_force
-                    || normal >= props.puncture_force
-                {
+                if normal >= props.puncture_force {
                     // Anchor the item point that now lies on the tine line,
                     // `d` behind the tip, so the coupling starts relaxed.
                     let s = d.max(0.0);
@@ -323,6 +321,9 @@ impl SkewerModel {
                     s = TINE_LENGTH;
                 }
                 let on_food = f_ax * u + f_lat;
+                if std::env::var("HIL_DEBUG2").is_ok() && on_food.norm() > 2.0 {
+                    eprintln!("pierced force {:.2} f_ax {f_ax:.2} f_lat {:.2} da {da:.5} dl {:.5} s {s:.4} cap {cap:.3}", on_food.norm(), f_lat.norm(), dl.norm());
+                }
                 out_food[food].add_at(on_food, f.com, f.com);
                 fork.add_at(-on_food, pt, fork_com);
                 TineState::Pierced {

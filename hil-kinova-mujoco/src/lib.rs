@@ -34,6 +34,8 @@ pub use controller::{Action, ACTIONS};
 pub use error::KinovaError;
 pub use food::{FoodKind, FoodModel, FoodProps, Shape};
 pub use sim::{AttemptReport, Simulator};
+pub use calibrate::{calibrate, CalibrationReport, CalibrationRow};
+pub use env::{KinovaFeedingConfig, KinovaFeedingEnv};
 
 /// Does nothing; calling it keeps this crate (and its typetag registrations)
 /// linked into a binary that names its components only in configs.

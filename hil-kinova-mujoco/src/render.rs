@@ -1,1 +1,1 @@
-//! placeholder
+//! Offscreen rendering (see render docs).

@@ -221,6 +221,8 @@ pub struct FoodProps {
     pub friction: f64,
     /// Lateral load the flesh bears before a tine tears out (N per metre embedded).
     pub tear_per_m: f64,
+    /// Sideways slot a tine may cut before it tears out (m).
+    pub cut_limit: f64,
     /// True colour (RGB).
     pub colour: [f64; 3],
 }
@@ -251,6 +253,9 @@ pub struct FoodModel {
     pub friction: (f64, f64),
     /// Mean tear strength (N/m) and relative sd.
     pub tear_per_m: (f64, f64),
+    /// Sideways slot before a tine tears out, as a fraction of the item's
+    /// minor half-extent.
+    pub cut_fraction_of_width: f64,
 }
 
 impl FoodModel {
@@ -265,33 +270,36 @@ impl FoodModel {
                 puncture_force: (0.5, 0.3),
                 puncture_indent: 0.002,
                 cut_fraction: 0.3,
-                grip_per_m: (1.2, 0.5),
-                friction: (1.0, 0.3),
-                tear_per_m: (120.0, 0.3),
+                grip_per_m: (0.8, 0.5),
+                friction: (0.5, 0.3),
+                tear_per_m: (15.0, 0.3),
+                cut_fraction_of_width: 0.3,
             },
             FoodKind::Carrot => FoodModel {
                 kind,
                 dims: vec![0.0085, 0.020],
                 dims_rel_sd: 0.10,
                 density: 1030.0,
-                puncture_force: (6.8, 0.15),
+                puncture_force: (7.2, 0.12),
                 puncture_indent: 0.0022,
                 cut_fraction: 0.25,
                 grip_per_m: (20.0, 0.3),
                 friction: (0.8, 0.2),
                 tear_per_m: (1500.0, 0.3),
+                cut_fraction_of_width: 0.5,
             },
             FoodKind::Cantaloupe => FoodModel {
                 kind,
                 dims: vec![0.0135, 0.0125, 0.0120],
                 dims_rel_sd: 0.08,
                 density: 930.0,
-                puncture_force: (2.2, 0.25),
+                puncture_force: (2.7, 0.2),
                 puncture_indent: 0.002,
                 cut_fraction: 0.25,
                 grip_per_m: (5.0, 0.4),
                 friction: (0.8, 0.3),
                 tear_per_m: (200.0, 0.3),
+                cut_fraction_of_width: 0.4,
             },
         }
     }
@@ -324,7 +332,7 @@ impl FoodModel {
             }
         };
         let puncture_force = pos(self.puncture_force.0, self.puncture_force.1);
-        let props = FoodProps {
+        FoodProps {
             kind: self.kind,
             mass: shape.volume() * self.density,
             shape,
@@ -334,9 +342,9 @@ impl FoodModel {
             grip_per_m: pos(self.grip_per_m.0, self.grip_per_m.1),
             friction: pos(self.friction.0, self.friction.1),
             tear_per_m: pos(self.tear_per_m.0, self.tear_per_m.1),
+            cut_limit: self.cut_fraction_of_width * shape.half_extents()[1],
             colour: self.kind.colour(),
-        };
-        props
+        }
     }
 }
 

@@ -371,10 +371,6 @@ impl Simulator {
             xfrc[self.ids.food[k].body] = wrench6(w);
         }
         xfrc[self.ids.fork_body] = wrench6(&on_fork);
-        if std::env::var("HIL_DEBUG3").is_ok() && (self.data.time() * 1000.0).round() as u64 % 50 == 0 {
-            let b = self.ids.food[0].body;
-            eprintln!("t={:.3} banana z={:.4} f={:?} fork={:?} tines={:?}", self.data.time(), self.data.xpos()[b][2], on_food[0].force, on_fork.force, skewer.tines().iter().map(|t| match t { crate::skewer::TineState::Free => 'F', crate::skewer::TineState::Indenting{..} => 'I', crate::skewer::TineState::Pierced{..} => 'P', crate::skewer::TineState::Torn => 'T'}).collect::<String>());
-        }
         let t0 = Instant::now();
         self.data.step();
         self.timing.in_step += t0.elapsed();

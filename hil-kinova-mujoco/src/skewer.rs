@@ -18,8 +18,10 @@
 //!    when the load exceeds the cutting resistance (advancing) or the grip
 //!    (pulling off: grip per embedded metre plus friction times the lateral
 //!    bearing load — a tilted tine carries the item partly on its side,
-//!    which is why tilted-angled actions hold soft slices). Laterally, a load
-//!    above the tear strength (per embedded metre) tears the tine out.
+//!    which is why tilted-angled actions hold soft slices). Laterally the
+//!    flesh bears at most its tear strength (per embedded metre); beyond it
+//!    the tine cuts a slot sideways, and a slot longer than the item's cut
+//!    limit tears the tine out.
 //!    A tine whose anchor slides past its tip has lost the item.
 //!
 //! Item-side forces act at the item's centre of mass: the items are light
@@ -62,6 +64,8 @@ pub enum TineState {
         s: f64,
         /// Anchor offset at the previous step (world), for damping.
         prev: Vector3<f64>,
+        /// Length of the sideways slot cut so far (m).
+        cut: f64,
     },
     /// Torn out of the item; stays free for the rest of the attempt.
     Torn,
@@ -247,6 +251,7 @@ impl SkewerModel {
                         anchor: f.rot.transpose() * (on_line - f.pos),
                         s,
                         prev: Vector3::zeros(),
+                        cut: 0.0,
                     };
                 }
                 // Lateral: the tip drags the surface point by friction.
@@ -267,42 +272,49 @@ impl SkewerModel {
             }
             TineState::Pierced {
                 food,
-                anchor,
+                mut anchor,
                 mut s,
                 prev,
+                mut cut,
             } => {
                 let f = &foods[food];
                 let Some(props) = f.props else {
                     return TineState::Free;
                 };
-                let pf = f.pos + f.rot * anchor;
                 let pt = tp.tip - s * u;
-                let delta = pf - pt;
+                let mut delta = f.pos + f.rot * anchor - pt;
                 let k = COUPLING_STIFFNESS * props.mass / (self.dt * self.dt);
                 let c = COUPLING_DAMPING * props.mass / self.dt;
+                let embedded = embedded_length(tp, f, props);
+                // Lateral: the flesh bears at most `yield_lat`; beyond it the
+                // tine cuts sideways (the anchor moves with it). A slot longer
+                // than the item's cut limit means the tine has torn out.
+                let da = delta.dot(&u);
+                let dl = delta - da * u;
+                let yield_lat = props.tear_per_m * embedded.max(0.004);
+                if k * dl.norm() > yield_lat {
+                    let excess = dl * (1.0 - yield_lat / (k * dl.norm()));
+                    cut += excess.norm();
+                    anchor -= f.rot.transpose() * excess;
+                    delta -= excess;
+                    if cut > props.cut_limit {
+                        self.stats.torn += 1;
+                        return TineState::Torn;
+                    }
+                }
+                let dl = delta - da * u;
                 let vel = if prev == Vector3::zeros() {
                     Vector3::zeros()
                 } else {
                     (delta - prev) / self.dt
                 };
-                let da = delta.dot(&u);
-                let dl = delta - da * u;
                 let f_lat = -k * dl - c * (vel - vel.dot(&u) * u);
-                let embedded = embedded_length(tp, f, props);
-                // Tearing is judged on the elastic (spring) load, not on
-                // damping transients.
-                if k * dl.norm() > props.tear_per_m * embedded.max(0.004) {
-                    if std::env::var("HIL_DEBUG").is_ok() {
-                        eprintln!("tear: k={k:.1} dl={:.5} emb={embedded:.4} tear={:.3} s={s:.4} da={da:.5}", dl.norm(), props.tear_per_m);
-                    }
-                    self.stats.torn += 1;
-                    return TineState::Torn;
-                }
                 let mut f_ax = -k * da - c * vel.dot(&u);
                 // da > 0: the item moves towards the tip (sliding off);
-                // da < 0: the tine advances into the item.
+                // da < 0: the tine advances into the item. Grip uses the
+                // elastic lateral load (bearing pressure), not damping.
                 let cap = if da > 0.0 {
-                    props.grip_per_m * embedded + props.friction * f_lat.norm()
+                    props.grip_per_m * embedded + props.friction * k * dl.norm()
                 } else {
                     props.cut_resistance
                 };
@@ -321,9 +333,6 @@ impl SkewerModel {
                     s = TINE_LENGTH;
                 }
                 let on_food = f_ax * u + f_lat;
-                if std::env::var("HIL_DEBUG2").is_ok() && on_food.norm() > 2.0 {
-                    eprintln!("pierced force {:.2} f_ax {f_ax:.2} f_lat {:.2} da {da:.5} dl {:.5} s {s:.4} cap {cap:.3}", on_food.norm(), f_lat.norm(), dl.norm());
-                }
                 out_food[food].add_at(on_food, f.com, f.com);
                 fork.add_at(-on_food, pt, fork_com);
                 TineState::Pierced {
@@ -331,6 +340,7 @@ impl SkewerModel {
                     anchor,
                     s,
                     prev: dl + da_new * u,
+                    cut,
                 }
             }
         }

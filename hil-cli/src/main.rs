@@ -22,6 +22,10 @@ struct Cli {
 enum Command {
     /// Run an experiment described by a TOML config.
     Run(cmd::run::RunArgs),
+    /// Demonstrations (`hil demo kinova`: the user study in MuJoCo).
+    Demo(cmd::kinova::DemoArgs),
+    /// The MuJoCo Kinova Gen3 feeding simulation (`hil kinova calibrate`).
+    Kinova(cmd::kinova::KinovaArgs),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +38,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Demo(args) => cmd::kinova::demo(args),
+        Command::Kinova(args) => cmd::kinova::kinova(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

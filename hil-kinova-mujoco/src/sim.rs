@@ -116,7 +116,7 @@ pub struct Timing {
 }
 
 /// Called with a phase name and the physics state at each keyframe.
-pub type KeyframeHook<'a> = &'a mut dyn FnMut(&str, &MjData<Box<MjModel>>);
+pub type KeyframeHook<'a> = &'a mut dyn FnMut(&str, &mut MjData<Box<MjModel>>);
 
 /// The MuJoCo simulation of the feeding scene.
 #[derive(Debug)]
@@ -404,7 +404,7 @@ impl Simulator {
         let q_pre = self.kin.solve(&self.home, fork, &PoseTarget { tip: pre, base }, "pre-pose")?;
         let mut skewer = SkewerModel::new(target.index(), self.dt);
         if let Some(k) = keyframe.as_mut() {
-            k("start", &self.data);
+            k("start", &mut self.data);
         }
 
         // Pre-pose: joint-space minimum-jerk move; the fork motors turn to β.
@@ -426,7 +426,7 @@ impl Simulator {
         let reached_roll = self.row_angle_to(perceived.yaw);
         let tare = self.wrist_force();
         if let Some(k) = keyframe.as_mut() {
-            k("pre_pose", &self.data);
+            k("pre_pose", &mut self.data);
         }
 
         // Approach and penetrate along the tines.
@@ -461,7 +461,7 @@ impl Simulator {
         }
         self.check_finite("penetration")?;
         if let Some(k) = keyframe.as_mut() {
-            k("skewer", &self.data);
+            k("skewer", &mut self.data);
         }
 
         // Lift straight up, then hold.
@@ -479,14 +479,14 @@ impl Simulator {
             self.physics_step(&mut skewer)?;
         }
         if let Some(k) = keyframe.as_mut() {
-            k("lift", &self.data);
+            k("lift", &mut self.data);
         }
         for _ in 0..(HOLD / self.dt) as usize {
             self.physics_step(&mut skewer)?;
         }
         self.check_finite("hold")?;
         if let Some(k) = keyframe.as_mut() {
-            k("hold", &self.data);
+            k("hold", &mut self.data);
         }
         let b = self.ids.food[target.index()].body;
         let height = self.data.xpos()[b][2] - self.plate_top_centre().z;

@@ -75,7 +75,10 @@ pub fn calibrate_foods(
         for (a, action) in ACTIONS.iter().enumerate() {
             let mut successes = 0;
             for t in 0..trials {
-                env.reset(seed.wrapping_mul(1_000_003).wrapping_add((food.index() * 6 + a) as u64 * 10_007 + t as u64))?;
+                env.reset(
+                    seed.wrapping_mul(1_000_003)
+                        .wrapping_add((food.index() * 6 + a) as u64 * 10_007 + t as u64),
+                )?;
                 env.next_item()?;
                 env.observe()?;
                 if env.execute(ArmId(a))?.success {

@@ -34,12 +34,42 @@ pub struct Action {
 
 /// The six actions in hil-core's arm order: VS0 VS90 TV0 TV90 TA0 TA90.
 pub const ACTIONS: [Action; 6] = [
-    Action { name: "VS0", pitch: 0.0, roll: 0.0, max_force: 25.0 },
-    Action { name: "VS90", pitch: 0.0, roll: std::f64::consts::FRAC_PI_2, max_force: 25.0 },
-    Action { name: "TV0", pitch: -0.5, roll: 0.0, max_force: 20.0 },
-    Action { name: "TV90", pitch: -0.5, roll: std::f64::consts::FRAC_PI_2, max_force: 20.0 },
-    Action { name: "TA0", pitch: 0.4, roll: 0.0, max_force: 10.0 },
-    Action { name: "TA90", pitch: 0.4, roll: std::f64::consts::FRAC_PI_2, max_force: 10.0 },
+    Action {
+        name: "VS0",
+        pitch: 0.0,
+        roll: 0.0,
+        max_force: 25.0,
+    },
+    Action {
+        name: "VS90",
+        pitch: 0.0,
+        roll: std::f64::consts::FRAC_PI_2,
+        max_force: 25.0,
+    },
+    Action {
+        name: "TV0",
+        pitch: -0.5,
+        roll: 0.0,
+        max_force: 20.0,
+    },
+    Action {
+        name: "TV90",
+        pitch: -0.5,
+        roll: std::f64::consts::FRAC_PI_2,
+        max_force: 20.0,
+    },
+    Action {
+        name: "TA0",
+        pitch: 0.4,
+        roll: 0.0,
+        max_force: 10.0,
+    },
+    Action {
+        name: "TA90",
+        pitch: 0.4,
+        roll: std::f64::consts::FRAC_PI_2,
+        max_force: 10.0,
+    },
 ];
 
 /// Curvature of the tines towards the fork's +z (rad), from the MJCF.
@@ -106,7 +136,10 @@ impl Kinematics {
         }
         self.data.kinematics();
         self.data.com_pos();
-        (self.site_pos(self.ids.tip_site), self.site_rot(self.ids.wrist_site))
+        (
+            self.site_pos(self.ids.tip_site),
+            self.site_rot(self.ids.wrist_site),
+        )
     }
 
     /// Position of a body's frame after the last [`forward`](Self::forward).

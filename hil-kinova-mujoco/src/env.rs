@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 use crate::controller::ACTIONS;
 use crate::food::{FoodKind, FoodModel, FoodProps};
 use crate::model::MjcfSource;
-use crate::perception::{perceive, Embedding, Observation, PerceptionNoise};
+use crate::perception::{Embedding, Observation, PerceptionNoise, perceive};
 use crate::sim::{AttemptReport, KeyframeHook, Placement, Simulator};
 
 /// Configuration of [`KinovaFeedingEnv`] (`type = "kinova_feeding"`).
@@ -79,7 +79,11 @@ impl Default for KinovaFeedingConfig {
 impl KinovaFeedingConfig {
     fn foods(&self) -> Result<Vec<FoodKind>> {
         if self.plate.is_empty() {
-            return Err(HilError::invalid_parameter("plate", "[]", "needs at least one item"));
+            return Err(HilError::invalid_parameter(
+                "plate",
+                "[]",
+                "needs at least one item",
+            ));
         }
         self.plate
             .iter()
@@ -112,7 +116,11 @@ impl KinovaFeedingConfig {
             ("noise.colour", n.colour),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(HilError::invalid_parameter(name, v.to_string(), "must be finite and ≥ 0"));
+                return Err(HilError::invalid_parameter(
+                    name,
+                    v.to_string(),
+                    "must be finite and ≥ 0",
+                ));
             }
         }
         Ok(())
@@ -166,7 +174,10 @@ impl KinovaFeedingEnv {
         };
         Ok(Self {
             foods: cfg.foods()?,
-            models: FoodKind::ALL.iter().map(|&k| FoodModel::default_for(k)).collect(),
+            models: FoodKind::ALL
+                .iter()
+                .map(|&k| FoodModel::default_for(k))
+                .collect(),
             embedding: Embedding::new(cfg.context_dim, cfg.embedding_seed),
             sim,
             actions: ActionSpace::feeding(),
@@ -189,16 +200,19 @@ impl KinovaFeedingEnv {
     }
 
     /// Like [`Environment::execute`], calling `keyframe` at each phase.
-    pub fn execute_with(&mut self, arm: ArmId, keyframe: Option<KeyframeHook<'_>>) -> Result<Outcome> {
+    pub fn execute_with(
+        &mut self,
+        arm: ArmId,
+        keyframe: Option<KeyframeHook<'_>>,
+    ) -> Result<Outcome> {
         self.actions.check(arm)?;
         let cur = self
             .current
             .as_mut()
             .ok_or_else(|| HilError::state("kinova_feeding", "execute called before next_item"))?;
-        let obs = cur
-            .observation
-            .take()
-            .ok_or_else(|| HilError::state("kinova_feeding", "execute called without a fresh observe"))?;
+        let obs = cur.observation.take().ok_or_else(|| {
+            HilError::state("kinova_feeding", "execute called without a fresh observe")
+        })?;
         let report = self.sim.execute(&ACTIONS[arm.0], &obs.target, keyframe)?;
         let success = report.success;
         self.last = Some(report);
@@ -233,7 +247,9 @@ impl KinovaFeedingEnv {
                     break;
                 }
             }
-            let yaw = self.rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+            let yaw = self
+                .rng
+                .random_range(-std::f64::consts::PI..std::f64::consts::PI);
             placed.push(Placement { props, xy, yaw });
         }
         placed
@@ -284,7 +300,12 @@ impl Environment for KinovaFeedingEnv {
     fn observe(&mut self) -> Result<Context> {
         let props = match &self.current {
             Some(c) => c.props.clone(),
-            None => return Err(HilError::state("kinova_feeding", "observe called before next_item")),
+            None => {
+                return Err(HilError::state(
+                    "kinova_feeding",
+                    "observe called before next_item",
+                ));
+            }
         };
         // Items already eaten are gone; the current one is `cursor - 1`.
         self.cursor -= 1;
@@ -317,7 +338,9 @@ impl Environment for KinovaFeedingEnv {
     }
 
     fn best_action(&self) -> Option<ArmId> {
-        self.current.as_ref().map(|c| ArmId(c.props.kind.expert_action()))
+        self.current
+            .as_ref()
+            .map(|c| ArmId(c.props.kind.expert_action()))
     }
 
     fn current_item(&self) -> Option<&Item> {

@@ -312,7 +312,11 @@ impl FoodModel {
             // Truncate at ±2.5 sd so no property turns non-physical.
             (mean * (1.0 + rel * z.clamp(-2.5, 2.5))).max(mean * 0.05)
         };
-        let d: Vec<f64> = self.dims.iter().map(|&m| pos(m, self.dims_rel_sd)).collect();
+        let d: Vec<f64> = self
+            .dims
+            .iter()
+            .map(|&m| pos(m, self.dims_rel_sd))
+            .collect();
         let shape = match self.kind {
             FoodKind::Banana => Shape::Disc {
                 radius: d[0],

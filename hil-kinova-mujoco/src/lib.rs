@@ -28,14 +28,13 @@ pub mod render;
 pub mod sim;
 pub mod skewer;
 
+pub use controller::{ACTIONS, Action};
 
-pub use controller::{Action, ACTIONS};
-
+pub use calibrate::{CalibrationReport, CalibrationRow, calibrate};
+pub use env::{KinovaFeedingConfig, KinovaFeedingEnv};
 pub use error::KinovaError;
 pub use food::{FoodKind, FoodModel, FoodProps, Shape};
 pub use sim::{AttemptReport, Simulator};
-pub use calibrate::{calibrate, CalibrationReport, CalibrationRow};
-pub use env::{KinovaFeedingConfig, KinovaFeedingEnv};
 
 /// Does nothing; calling it keeps this crate (and its typetag registrations)
 /// linked into a binary that names its components only in configs.

@@ -150,7 +150,12 @@ fn resolve(model: &MjModel, origin: &str) -> Result<SceneIds, KinovaError> {
     for kind in FoodKind::ALL {
         let body = id(model, origin, mjOBJ_BODY, &kind.body_name())?;
         let geom = id(model, origin, mjOBJ_GEOM, &kind.geom_name())?;
-        let joint = id(model, origin, mjOBJ_JOINT, &format!("{}_free", kind.body_name()))?;
+        let joint = id(
+            model,
+            origin,
+            mjOBJ_JOINT,
+            &format!("{}_free", kind.body_name()),
+        )?;
         if jnt_type[joint] != MjtJoint::mjJNT_FREE {
             return Err(KinovaError::MjcfInvalid {
                 origin: origin.into(),

@@ -235,6 +235,9 @@ mod tests {
             assert!(e.iter().all(|v| v.is_finite()));
             assert_eq!(e, Embedding::new(d, 3).embed(&raw));
         }
-        assert_ne!(Embedding::new(20, 3).embed(&raw), Embedding::new(20, 4).embed(&raw));
+        assert_ne!(
+            Embedding::new(20, 3).embed(&raw),
+            Embedding::new(20, 4).embed(&raw)
+        );
     }
 }

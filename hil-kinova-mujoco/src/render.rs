@@ -45,7 +45,13 @@ impl KeyframeRecorder {
         self.frames.len()
     }
 
-    fn record(&mut self, item: &str, phase: &str, sim_geoms: [usize; 3], data: &MjData<Box<MjModel>>) {
+    fn record(
+        &mut self,
+        item: &str,
+        phase: &str,
+        sim_geoms: [usize; 3],
+        data: &MjData<Box<MjModel>>,
+    ) {
         if phase == "start" {
             self.attempt += 1;
         }
@@ -75,7 +81,8 @@ impl KeyframeWriter {
     /// Opens an offscreen renderer for `sim`'s model, writing into `dir`
     /// (created if missing). Errors say why rendering is unavailable.
     pub fn new(dir: &Path, sim: &Simulator) -> std::result::Result<Self, String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         Self::open(dir, sim)
     }
 
@@ -134,6 +141,9 @@ impl KeyframeWriter {
                 .sync_data(&mut self.data)
                 .map_err(|e| format!("rendering {}: {e}", frame.name))?;
             self.renderer
+                .render()
+                .map_err(|e| format!("rendering {}: {e}", frame.name))?;
+            self.renderer
                 .save_rgb(&path)
                 .map_err(|e| format!("writing {}: {e}", path.display()))?;
             self.written += 1;
@@ -190,7 +200,8 @@ impl Environment for RenderingEnv<'_> {
             .unwrap_or_default();
         let geoms = self.env.simulator().ids().food.map(|f| f.geom);
         let rec = &mut *self.recorder;
-        let mut hook = |phase: &str, data: &mut MjData<Box<MjModel>>| rec.record(&item, phase, geoms, data);
+        let mut hook =
+            |phase: &str, data: &mut MjData<Box<MjModel>>| rec.record(&item, phase, geoms, data);
         self.env.execute_with(arm, Some(&mut hook))
     }
     fn best_action(&self) -> Option<ArmId> {

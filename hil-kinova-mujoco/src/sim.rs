@@ -8,11 +8,11 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use serde::Serialize;
 
 use crate::controller::{
-    fork_base_orientation, min_jerk, tine_direction, Action, Kinematics, PoseTarget,
+    Action, Kinematics, PoseTarget, fork_base_orientation, min_jerk, tine_direction,
 };
 use crate::error::KinovaError;
 use crate::food::{FoodKind, FoodProps, Shape};
-use crate::model::{self, MjcfSource, SceneIds, N_TINES};
+use crate::model::{self, MjcfSource, N_TINES, SceneIds};
 use crate::skewer::{FoodView, SkewerModel, SkewerStats, TinePose, Wrench};
 
 /// Height of the plate's top surface above its body frame (m).
@@ -159,7 +159,7 @@ impl Simulator {
             tip: plate_centre + Vector3::new(0.0, 0.0, 0.15),
             base: fork_base_orientation(0.0),
         };
-        let seed = [0.0, 0.35, -2.0, 0.0, -0.9, 1.5708];
+        let seed = [0.0, 0.35, -2.0, 0.0, -0.9, std::f64::consts::FRAC_PI_2];
         let home = kin.solve(&seed, [0.0, 0.0], &home_target, "home pose above the plate")?;
         Ok(Self {
             data,
@@ -206,14 +206,21 @@ impl Simulator {
 
     /// Places `items` on the plate (at most one per kind; the others are put
     /// aside), lets them settle, and returns their true poses.
-    pub fn stage(&mut self, items: &[Placement], target: FoodKind) -> Result<Vec<TruePose>, KinovaError> {
+    pub fn stage(
+        &mut self,
+        items: &[Placement],
+        target: FoodKind,
+    ) -> Result<Vec<TruePose>, KinovaError> {
         let start = Instant::now();
         let mut props: [Option<FoodProps>; 3] = [None, None, None];
         for p in items {
             if props[p.props.kind.index()].is_some() {
                 return Err(KinovaError::MjcfInvalid {
                     origin: "scene".into(),
-                    what: format!("the scene has one body per food kind; {} appears twice", p.props.kind.name()),
+                    what: format!(
+                        "the scene has one body per food kind; {} appears twice",
+                        p.props.kind.name()
+                    ),
                 });
             }
             props[p.props.kind.index()] = Some(p.props.clone());
@@ -257,7 +264,10 @@ impl Simulator {
                             p.yaw,
                         )
                     }
-                    None => (Vector3::new(-0.6, -0.3 + 0.3 * kind.index() as f64, 0.05), 0.0),
+                    None => (
+                        Vector3::new(-0.6, -0.3 + 0.3 * kind.index() as f64, 0.05),
+                        0.0,
+                    ),
                 };
                 let q = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw);
                 qpos[f.qpos..f.qpos + 3].copy_from_slice(pos.as_slice());
@@ -282,10 +292,17 @@ impl Simulator {
     fn apply_props(&mut self, kind: FoodKind, p: &FoodProps) {
         let f = self.ids.food[kind.index()];
         let (size, aabb) = match p.shape {
-            Shape::Disc { radius, half_height } => ([radius, half_height, 0.0], [radius, radius, half_height]),
-            Shape::Capsule { radius, half_length } => {
-                ([radius, half_length, 0.0], [radius, radius, half_length + radius])
-            }
+            Shape::Disc {
+                radius,
+                half_height,
+            } => ([radius, half_height, 0.0], [radius, radius, half_height]),
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => (
+                [radius, half_length, 0.0],
+                [radius, radius, half_length + radius],
+            ),
             Shape::Cuboid { half } => (half, half),
         };
         // Items weigh grams and their rotational inertia is tiny; a floor
@@ -296,9 +313,12 @@ impl Simulator {
         // geom in that frame, so the frame stays and the diagonal is
         // expressed in it (the shapes are symmetric: a permutation).
         let iq = self.data.model().body_iquat()[f.body];
-        let r = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(iq[0], iq[1], iq[2], iq[3]))
-            .to_rotation_matrix();
-        let inertial = r.matrix().transpose() * Matrix3::from_diagonal(&Vector3::from(body_frame)) * r.matrix();
+        let r =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(iq[0], iq[1], iq[2], iq[3]))
+                .to_rotation_matrix();
+        let inertial = r.matrix().transpose()
+            * Matrix3::from_diagonal(&Vector3::from(body_frame))
+            * r.matrix();
         let inertia = [inertial[(0, 0)], inertial[(1, 1)], inertial[(2, 2)]];
         // SAFETY: only sizes, masses and inertias of existing elements change;
         // no count, address or array size of the model is touched.
@@ -401,7 +421,9 @@ impl Simulator {
         let c = Vector3::from(perceived.centre);
         let entry = c + Vector3::new(0.0, 0.0, perceived.half_height);
         let pre = entry - PRE_OFFSET * u;
-        let q_pre = self.kin.solve(&self.home, fork, &PoseTarget { tip: pre, base }, "pre-pose")?;
+        let q_pre = self
+            .kin
+            .solve(&self.home, fork, &PoseTarget { tip: pre, base }, "pre-pose")?;
         let mut skewer = SkewerModel::new(target.index(), self.dt);
         if let Some(k) = keyframe.as_mut() {
             k("start", &mut self.data);
@@ -440,7 +462,10 @@ impl Simulator {
             let v = if travel < approach { 0.10 } else { 0.03 };
             travel += v * self.dt;
             if step_i % 2 == 0 {
-                let target = PoseTarget { tip: pre + travel * u, base };
+                let target = PoseTarget {
+                    tip: pre + travel * u,
+                    base,
+                };
                 q = self.kin.dls_step(&q, fork, &target, 0.05).0;
             }
             step_i += 1;
@@ -471,7 +496,10 @@ impl Simulator {
         while lift < LIFT {
             lift += 0.10 * self.dt;
             if step_i % 2 == 0 {
-                let target = PoseTarget { tip: tip0 + Vector3::new(0.0, 0.0, lift), base };
+                let target = PoseTarget {
+                    tip: tip0 + Vector3::new(0.0, 0.0, lift),
+                    base,
+                };
                 q = self.kin.dls_step(&q, fork, &target, 0.05).0;
             }
             step_i += 1;
@@ -523,16 +551,23 @@ impl Simulator {
     }
 
     fn check_finite(&self, phase: &'static str) -> Result<(), KinovaError> {
-        if self.data.qpos().iter().all(|v| v.is_finite()) && self.data.warning()[MjtWarning::mjWARN_BADQACC as usize].number == 0 {
+        if self.data.qpos().iter().all(|v| v.is_finite())
+            && self.data.warning()[MjtWarning::mjWARN_BADQACC as usize].number == 0
+        {
             Ok(())
         } else {
-            Err(KinovaError::Diverged { time: self.data.time(), phase })
+            Err(KinovaError::Diverged {
+                time: self.data.time(),
+                phase,
+            })
         }
     }
 }
 
 fn wrench6(w: &Wrench) -> [f64; 6] {
-    [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z]
+    [
+        w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z,
+    ]
 }
 
 /// Wraps an angle to (−π/2, π/2]: a tine row is the same line turned by π.

@@ -44,16 +44,28 @@ fn forward_kinematics_matches_the_fact_sheet() {
     // q = 0: end_effector_link at (0, 0.0014, 1.1766) above base_link.
     kin.forward(&[0.0; 6], [0.0, 0.0]);
     let ee = kin.site_pos(ee_site) - base;
-    assert!((ee - Vector3::new(0.0, 0.0014, 1.1766)).norm() < 1e-3, "q=0: {ee:?}");
+    assert!(
+        (ee - Vector3::new(0.0, 0.0014, 1.1766)).norm() < 1e-3,
+        "q=0: {ee:?}"
+    );
     // FLAIR's acquisition pose (0..2π values wrapped): fork tip at about
     // (0.314, −0.002, 0.345), tines pointing down.
-    let wrap = |a: f64| (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    let wrap = |a: f64| {
+        (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+    };
     let acq = [0.0296, 0.0665, 5.2812, 3.1258, 2.0499, 4.7379].map(wrap);
     let (tip, base_rot) = kin.forward(&acq, [0.0, 0.0]);
     let tip = tip - base;
-    assert!((tip - Vector3::new(0.314, -0.002, 0.345)).norm() < 0.01, "acq tip {tip:?}");
+    assert!(
+        (tip - Vector3::new(0.314, -0.002, 0.345)).norm() < 0.01,
+        "acq tip {tip:?}"
+    );
     // The fork base's x axis is the handle at β = 0.
-    assert!(base_rot.column(0).dot(&-Vector3::z()) > 0.99, "handle {:?}", base_rot.column(0));
+    assert!(
+        base_rot.column(0).dot(&-Vector3::z()) > 0.99,
+        "handle {:?}",
+        base_rot.column(0)
+    );
 }
 
 #[test]
@@ -63,7 +75,11 @@ fn every_action_reaches_its_commanded_pitch_and_roll() {
     for (i, action) in ACTIONS.iter().enumerate() {
         let props = FoodModel::default_for(FoodKind::Cantaloupe).sample(&mut rng);
         let yaw = -1.0 + 0.4 * i as f64;
-        let items = vec![Placement { props, xy: [0.01, -0.01], yaw }];
+        let items = vec![Placement {
+            props,
+            xy: [0.01, -0.01],
+            yaw,
+        }];
         let pose = sim.stage(&items, FoodKind::Cantaloupe).unwrap()[0];
         let perceived = PerceivedTarget {
             centre: pose.centre,
@@ -71,8 +87,18 @@ fn every_action_reaches_its_commanded_pitch_and_roll() {
             half_height: pose.half_extents[2],
         };
         let r = sim.execute(action, &perceived, None).unwrap();
-        assert!((r.reached_pitch - action.pitch).abs() < 0.03, "{}: pitch {}", action.name, r.reached_pitch);
-        assert!((r.reached_roll - action.roll).abs() < 0.05, "{}: roll {}", action.name, r.reached_roll);
+        assert!(
+            (r.reached_pitch - action.pitch).abs() < 0.03,
+            "{}: pitch {}",
+            action.name,
+            r.reached_pitch
+        );
+        assert!(
+            (r.reached_roll - action.roll).abs() < 0.05,
+            "{}: roll {}",
+            action.name,
+            r.reached_roll
+        );
         assert!(r.tines.touched >= 2, "{}: tines {:?}", action.name, r.tines);
     }
 }
@@ -95,11 +121,8 @@ fn the_same_seed_replays_the_same_attempts() {
 
 #[test]
 fn passes_the_environment_conformance_suite() {
-    let report = check_environment(
-        &|| Ok(Box::new(small_env()) as Box<dyn Environment>),
-        1,
-    )
-    .unwrap();
+    let report =
+        check_environment(&|| Ok(Box::new(small_env()) as Box<dyn Environment>), 1).unwrap();
     assert!(!report.passed.is_empty(), "{report:?}");
 }
 
@@ -149,13 +172,21 @@ fn missing_and_malformed_mjcf_files_are_clear_errors() {
     assert!(err.to_string().contains("nope.xml"), "{err}");
 
     let bad = dir.join("bad.xml");
-    std::fs::write(&bad, "<mujoco>\n  <worldbody>\n    <body name=\"a\">\n</mujoco>\n").unwrap();
+    std::fs::write(
+        &bad,
+        "<mujoco>\n  <worldbody>\n    <body name=\"a\">\n</mujoco>\n",
+    )
+    .unwrap();
     let err = model::load(MjcfSource::File(&bad)).unwrap_err();
     assert!(matches!(err, KinovaError::MjcfMalformed { .. }), "{err}");
     assert!(err.to_string().contains("bad.xml"), "{err}");
 
     let lacking = dir.join("lacking.xml");
-    std::fs::write(&lacking, "<mujoco><worldbody><geom type=\"sphere\" size=\"0.1\"/></worldbody></mujoco>").unwrap();
+    std::fs::write(
+        &lacking,
+        "<mujoco><worldbody><geom type=\"sphere\" size=\"0.1\"/></worldbody></mujoco>",
+    )
+    .unwrap();
     let err = model::load(MjcfSource::File(&lacking)).unwrap_err();
     assert!(err.to_string().contains("joint_1"), "{err}");
 

@@ -114,7 +114,11 @@ pub fn demo(args: DemoArgs) -> Result<()> {
 
 fn calibrate(args: CalibrateArgs) -> Result<()> {
     if args.trials == 0 {
-        return Err(HilError::invalid_parameter("--trials", "0", "must be at least 1"));
+        return Err(HilError::invalid_parameter(
+            "--trials",
+            "0",
+            "must be at least 1",
+        ));
     }
     let foods: Vec<FoodKind> = if args.foods.is_empty() {
         FoodKind::ALL.to_vec()
@@ -149,7 +153,10 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         );
         return Ok(());
     }
-    println!("Simulated success rate (published rate) per action; {} trials each.", args.trials);
+    println!(
+        "Simulated success rate (published rate) per action; {} trials each.",
+        args.trials
+    );
     println!("Simulated attempts with synthetic food properties; published: Feng et al. 2019.");
     print!("{:<12}", "food");
     for a in hil_core::FEEDING_ACTIONS {
@@ -240,11 +247,18 @@ fn components(path: Option<&Path>) -> Result<toml::Table> {
         return Ok(toml::Table::new());
     };
     let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
-    let table: toml::Table = toml::from_str(&text).map_err(|e| {
-        HilError::invalid_input(path.display().to_string(), e.to_string())
-    })?;
+    let table: toml::Table = toml::from_str(&text)
+        .map_err(|e| HilError::invalid_input(path.display().to_string(), e.to_string()))?;
     for key in table.keys() {
-        if !["linucb", "always_query", "linucb_qg", "workload", "environment"].contains(&key.as_str()) {
+        if ![
+            "linucb",
+            "always_query",
+            "linucb_qg",
+            "workload",
+            "environment",
+        ]
+        .contains(&key.as_str())
+        {
             return Err(HilError::invalid_input(
                 format!("{}: table `{key}`", path.display()),
                 "unknown; expected linucb, always_query, linucb_qg, workload or environment",
@@ -296,9 +310,10 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
     }
     let table = components(args.components.as_deref())?;
     let env_cfg: KinovaFeedingConfig = match table.get("environment") {
-        Some(v) => v.clone().try_into().map_err(|e: toml::de::Error| {
-            HilError::invalid_input("environment", e.to_string())
-        })?,
+        Some(v) => v
+            .clone()
+            .try_into()
+            .map_err(|e: toml::de::Error| HilError::invalid_input("environment", e.to_string()))?,
         None => KinovaFeedingConfig::default(),
     };
     let mut env = KinovaFeedingEnv::new(env_cfg)?;
@@ -314,9 +329,9 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
     let workload = workload_config(&table)?.build(&ctx)?;
     let mut policies = Vec::new();
     for (label, key) in METHODS {
-        let p = policy_config(&table, key)?.build(&ctx).map_err(|e| {
-            HilError::invalid_input(format!("policy {label}"), e.to_string())
-        })?;
+        let p = policy_config(&table, key)?
+            .build(&ctx)
+            .map_err(|e| HilError::invalid_input(format!("policy {label}"), e.to_string()))?;
         policies.push(p);
     }
     let mut writer = match &args.render {
@@ -401,10 +416,16 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
             "methods": summary,
             "note": "MuJoCo simulation of the user-study protocol; food properties are synthetic, calibrated to published success rates",
         });
-        println!("{}", serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
+        );
     } else {
         println!("User-study protocol in MuJoCo simulation (synthetic food properties).");
-        println!("{:<12} {:>4} {:>4} {:>11} {:>10} {:>4}", "method", "rep", "pos", "r_task_avg", "n_success", "n_q");
+        println!(
+            "{:<12} {:>4} {:>4} {:>11} {:>10} {:>4}",
+            "method", "rep", "pos", "r_task_avg", "n_success", "n_q"
+        );
         for p in &plates {
             println!(
                 "{:<12} {:>4} {:>4} {:>11.3} {:>10} {:>4}",

@@ -1,4 +1,4 @@
 //! One module per subcommand.
 
-pub mod run;
 pub mod kinova;
+pub mod run;

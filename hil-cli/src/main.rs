@@ -26,6 +26,8 @@ enum Command {
     Demo(cmd::kinova::DemoArgs),
     /// The MuJoCo Kinova Gen3 feeding simulation (`hil kinova calibrate`).
     Kinova(cmd::kinova::KinovaArgs),
+    /// Benchmark components (e.g. `hil bench policy --policy linucb_qg`).
+    Bench(cmd::bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +42,7 @@ fn main() -> ExitCode {
         Command::Run(args) => cmd::run::run(args),
         Command::Demo(args) => cmd::kinova::demo(args),
         Command::Kinova(args) => cmd::kinova::kinova(args),
+        Command::Bench(args) => cmd::bench::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -16,9 +16,12 @@
 //! ```
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use hil_core::config::{BuildContext, EnvironmentConfig};
-use hil_core::{ActionSpace, ArmId, Context, Environment, HilError, Item, Outcome, Result};
+use hil_core::{
+    ActionSpace, ArmId, Context, Environment, HilError, Item, LabelledObservation, Outcome, Result,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -51,6 +54,12 @@ pub struct KinovaFeedingConfig {
     /// Perception noise.
     #[serde(default)]
     pub noise: PerceptionNoise,
+    /// Simulated attempts per (food, action) offered to policies as
+    /// pretraining data (`pretrain = true` in their configs); 0 offers none.
+    /// They are drawn from the plate's own foods on a separate seed stream
+    /// (the paper pretrained on other foods, which this scene lacks).
+    #[serde(default)]
+    pub pretraining_trials: usize,
 }
 
 fn default_plate() -> Vec<String> {
@@ -72,6 +81,7 @@ impl Default for KinovaFeedingConfig {
             neighbours: true,
             mjcf: None,
             noise: PerceptionNoise::default(),
+            pretraining_trials: 0,
         }
     }
 }
@@ -134,6 +144,50 @@ impl EnvironmentConfig for KinovaFeedingConfig {
         cfg.mjcf = cfg.mjcf.map(|p| ctx.resolve(&p));
         Ok(Box::new(KinovaFeedingEnv::new(cfg)?))
     }
+
+    fn pretraining(&self, ctx: &BuildContext) -> Result<Option<Arc<[LabelledObservation]>>> {
+        if self.pretraining_trials == 0 {
+            return Ok(None);
+        }
+        let mut cfg = self.clone();
+        cfg.mjcf = cfg.mjcf.map(|p| ctx.resolve(&p));
+        Ok(Some(simulated_pretraining(&cfg, ctx.seed)?.into()))
+    }
+}
+
+/// Seed stream of pretraining attempts (kept apart from episode seeds).
+const PRETRAIN_STREAM: u64 = 0x7072_6574_7261_696e;
+
+/// Runs `cfg.pretraining_trials` attempts of every action on every distinct
+/// food of the plate and returns them as labelled observations.
+pub fn simulated_pretraining(cfg: &KinovaFeedingConfig, seed: u64) -> Result<Vec<LabelledObservation>> {
+    let mut foods = cfg.foods()?;
+    foods.sort();
+    foods.dedup();
+    let mut out = Vec::new();
+    for food in foods {
+        let mut env = KinovaFeedingEnv::new(KinovaFeedingConfig {
+            plate: vec![food.name().to_string()],
+            neighbours: false,
+            pretraining_trials: 0,
+            ..cfg.clone()
+        })?;
+        for arm in 0..ACTIONS.len() {
+            for t in 0..cfg.pretraining_trials {
+                let stream = (food.index() * ACTIONS.len() + arm) * cfg.pretraining_trials + t;
+                env.reset(hil_core::session::splitmix(seed ^ PRETRAIN_STREAM, stream as u64))?;
+                env.next_item()?;
+                let context = env.observe()?;
+                let reward = env.execute(ArmId(arm))?.reward();
+                out.push(LabelledObservation {
+                    context,
+                    arm: ArmId(arm),
+                    reward,
+                });
+            }
+        }
+    }
+    Ok(out)
 }
 
 #[derive(Debug)]

@@ -268,15 +268,22 @@ fn components(path: Option<&Path>) -> Result<toml::Table> {
     Ok(table)
 }
 
+/// Default policy parameters of the demo (override with `--components`):
+/// α = 0.5 for all three, LinUCB-QG workload weight w = 0.3, all
+/// pretrained on the environment's simulated pretraining attempts.
+fn default_policy(key: &str) -> toml::Value {
+    let mut t = toml::Table::new();
+    t.insert("type".into(), toml::Value::String(key.into()));
+    t.insert("alpha".into(), toml::Value::Float(0.5));
+    t.insert("pretrain".into(), toml::Value::Boolean(true));
+    if key == "linucb_qg" {
+        t.insert("w".into(), toml::Value::Float(0.3));
+    }
+    toml::Value::Table(t)
+}
+
 fn policy_config(table: &toml::Table, key: &str) -> Result<Box<dyn PolicyConfig>> {
-    let value = match table.get(key) {
-        Some(v) => v.clone(),
-        None => {
-            let mut t = toml::Table::new();
-            t.insert("type".into(), toml::Value::String(key.into()));
-            toml::Value::Table(t)
-        }
-    };
+    let value = table.get(key).cloned().unwrap_or_else(|| default_policy(key));
     value.try_into().map_err(|e: toml::de::Error| {
         HilError::invalid_input(
             format!("policy `{key}`"),
@@ -314,9 +321,12 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
             .clone()
             .try_into()
             .map_err(|e: toml::de::Error| HilError::invalid_input("environment", e.to_string()))?,
-        None => KinovaFeedingConfig::default(),
+        None => KinovaFeedingConfig {
+            pretraining_trials: 2,
+            ..KinovaFeedingConfig::default()
+        },
     };
-    let mut env = KinovaFeedingEnv::new(env_cfg)?;
+    let mut env = KinovaFeedingEnv::new(env_cfg.clone())?;
     let base = args
         .components
         .as_deref()
@@ -326,6 +336,13 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
     let mut ctx = BuildContext::new(&base, args.seed);
     ctx.action_space = Some(env.action_space().clone());
     ctx.context_dim = Some(env.context_dim());
+    if !args.quiet && env_cfg.pretraining_trials > 0 {
+        eprintln!(
+            "simulating {} pretraining attempts per (food, action)",
+            env_cfg.pretraining_trials
+        );
+    }
+    ctx.pretraining = hil_core::config::EnvironmentConfig::pretraining(&env_cfg, &ctx)?;
     let workload = workload_config(&table)?.build(&ctx)?;
     let mut policies = Vec::new();
     for (label, key) in METHODS {

@@ -1,0 +1,188 @@
+//! The hil-core policy conformance suite for all four policies, in every
+//! representation, plus config loading and validation.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use hil_core::config::PolicyConfig;
+use hil_core::testing::check_policy;
+use hil_core::{ActionSpace, ArmId, BuildContext, Context, LabelledObservation, Policy, QueryKind};
+use hil_policies::{
+    AlwaysQuery, AlwaysQueryParams, EstimatorOptions, LinUcb, LinUcbExpDecay, LinUcbExpDecayParams,
+    LinUcbParams, LinUcbQg, LinUcbQgParams, LinearArms, RepresentationChoice,
+};
+
+const DIM: usize = 5;
+const ARMS: usize = 3;
+
+fn pretraining() -> Vec<LabelledObservation> {
+    (0..12)
+        .map(|i| LabelledObservation {
+            context: Context::new(
+                (0..DIM)
+                    .map(|j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.5)
+                    .collect::<Vec<_>>(),
+            )
+            .unwrap(),
+            arm: ArmId(i % ARMS),
+            reward: f64::from(i % 3 == 0),
+        })
+        .collect()
+}
+
+fn estimator(r: RepresentationChoice) -> LinearArms {
+    let opts = EstimatorOptions {
+        representation: r,
+        crossover: 1.0,
+    };
+    let mut arms = LinearArms::with_options(ARMS, DIM, 0.5, opts).unwrap();
+    arms.pretrain(&pretraining()).unwrap();
+    arms
+}
+
+type Factory = dyn Fn() -> hil_core::Result<Box<dyn Policy>>;
+
+fn all_policies(r: RepresentationChoice) -> Vec<Box<Factory>> {
+    let k = QueryKind::default();
+    vec![
+        Box::new(move || Ok(Box::new(LinUcb::new(LinUcbParams::new(0.8)?, estimator(r))))),
+        Box::new(move || {
+            Ok(Box::new(AlwaysQuery::new(
+                AlwaysQueryParams::new(0.8, k)?,
+                estimator(r),
+            )))
+        }),
+        Box::new(move || {
+            Ok(Box::new(LinUcbExpDecay::new(
+                LinUcbExpDecayParams::new(0.8, 0.05, k)?,
+                estimator(r),
+            )))
+        }),
+        Box::new(move || {
+            Ok(Box::new(LinUcbQg::new(
+                LinUcbQgParams::new(0.8, 0.3, k)?,
+                estimator(r),
+            )))
+        }),
+    ]
+}
+
+#[test]
+fn conformance_suite_passes_for_every_policy_and_representation() {
+    for r in [
+        RepresentationChoice::Auto,
+        RepresentationChoice::Kernel,
+        RepresentationChoice::Dense,
+    ] {
+        for make in all_policies(r) {
+            let report = check_policy(&*make).unwrap_or_else(|e| panic!("{r:?}: {e}"));
+            assert!(report.skipped.is_empty(), "{report:?}");
+            assert!(report.passed.contains(&"checkpoint"));
+        }
+    }
+}
+
+#[derive(serde::Deserialize)]
+struct Wrapper {
+    policy: Box<dyn PolicyConfig>,
+}
+
+fn ctx(pretrain: bool) -> BuildContext {
+    let mut c = BuildContext::new(".", 3);
+    c.action_space = Some(ActionSpace::feeding());
+    c.context_dim = Some(DIM);
+    if pretrain {
+        c.pretraining = Some(Arc::from(pretraining()));
+    }
+    c
+}
+
+fn build_err(toml_text: &str, c: &BuildContext) -> String {
+    match build(toml_text, c) {
+        Ok(p) => panic!("`{}` built from an invalid config", p.name()),
+        Err(e) => e,
+    }
+}
+
+fn build(toml_text: &str, c: &BuildContext) -> Result<Box<dyn Policy>, String> {
+    let w: Wrapper = hil_core::config::parse_toml(toml_text, Path::new("test.toml"))
+        .map_err(|e| e.to_string())?;
+    w.policy.build(c).map_err(|e| e.to_string())
+}
+
+#[test]
+fn configs_build_every_policy() {
+    let cases = [
+        ("linucb", "alpha = 0.5"),
+        (
+            "always_query",
+            "alpha = 0.5\nquery_kind = { difficulty = \"hard\" }",
+        ),
+        ("linucb_exp_decay", "alpha = 0.5\nc = 0.2\nseed = 9"),
+        (
+            "linucb_qg",
+            "alpha = 0.5\nw = 0.2\nlambda = 2.0\n[policy.estimator]\nrepresentation = \"dense\"",
+        ),
+    ];
+    for (name, body) in cases {
+        let text = format!("[policy]\ntype = \"{name}\"\npretrain = true\n{body}\n");
+        let p = build(&text, &ctx(true)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(p.name(), name);
+        assert_eq!((p.n_arms(), p.dim()), (6, DIM));
+    }
+}
+
+#[test]
+fn config_errors_name_the_value() {
+    let c = ctx(false);
+    let e = build_err("[policy]\ntype = \"linucb\"\nalpha = -1.0\n", &c);
+    assert!(e.contains("alpha") && e.contains("-1"), "{e}");
+    let e = build_err(
+        "[policy]\ntype = \"linucb\"\nalpha = 1.0\nlambda = 0.0\n",
+        &c,
+    );
+    assert!(e.contains("lambda") && e.contains("> 0"), "{e}");
+    let e = build_err(
+        "[policy]\ntype = \"linucb_qg\"\nalpha = 1.0\nw = -0.5\n",
+        &c,
+    );
+    assert!(e.contains("`w`") && e.contains("-0.5"), "{e}");
+    let e = build_err(
+        "[policy]\ntype = \"linucb_exp_decay\"\nalpha = 1.0\nc = -2\n",
+        &c,
+    );
+    assert!(e.contains("`c`"), "{e}");
+    let e = build_err(
+        "[policy]\ntype = \"linucb\"\nalpha = 1.0\nalhpa = 2.0\n",
+        &c,
+    );
+    assert!(e.contains("alhpa"), "{e}");
+    let e = build_err(
+        "[policy]\ntype = \"linucb\"\nalpha = 1.0\npretrain = true\n",
+        &c,
+    );
+    assert!(
+        e.contains("pretrain") && e.contains("no pretraining data"),
+        "{e}"
+    );
+    let e = build_err(
+        "[policy]\ntype = \"linucb\"\nalpha = 1.0\n",
+        &BuildContext::new(".", 0),
+    );
+    assert!(e.contains("action space"), "{e}");
+}
+
+#[test]
+fn pretrained_estimator_is_shared_by_clones() {
+    // Pretrain once, clone into two policies: they start identical.
+    let arms = estimator(RepresentationChoice::Auto);
+    let k = QueryKind::default();
+    let a = LinUcbQg::new(LinUcbQgParams::new(1.0, 0.1, k).unwrap(), arms.clone());
+    let b = LinUcb::new(LinUcbParams::new(1.0).unwrap(), arms);
+    let x = [0.1, 0.2, -0.3, 0.0, 0.5];
+    for arm in 0..ARMS {
+        let ea = a.estimator().estimate(ArmId(arm), &x).unwrap();
+        let eb = b.estimator().estimate(ArmId(arm), &x).unwrap();
+        assert_eq!(ea, eb);
+    }
+}

@@ -28,6 +28,8 @@ enum Command {
     Kinova(cmd::kinova::KinovaArgs),
     /// Benchmark components (e.g. `hil bench policy --policy linucb_qg`).
     Bench(cmd::bench::BenchArgs),
+    /// Inspect plugin libraries and check their types for conformance.
+    Plugins(cmd::plugins::PluginsArgs),
 }
 
 fn main() -> ExitCode {
@@ -37,12 +39,14 @@ fn main() -> ExitCode {
     hil_workload::link();
     hil_envs::link();
     hil_kinova_mujoco::link();
+    hil_channels::link();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Demo(args) => cmd::kinova::demo(args),
         Command::Kinova(args) => cmd::kinova::kinova(args),
         Command::Bench(args) => cmd::bench::run(args),
+        Command::Plugins(args) => cmd::plugins::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

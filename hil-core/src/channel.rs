@@ -22,6 +22,12 @@ pub trait QueryChannel: Send {
         let _ = seed;
     }
 
+    /// Where a person answers, for channels that serve one (e.g. the URL of
+    /// a web page), so that a front end can show it. None by default.
+    fn endpoint(&self) -> Option<String> {
+        None
+    }
+
     /// Asks the query and waits for the answer.
     fn ask(&mut self, query: &Query) -> Result<Response>;
 }

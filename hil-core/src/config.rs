@@ -132,15 +132,19 @@ pub struct ExperimentConfig {
     #[serde(default)]
     pub session: SessionSettings,
     /// Where the robot acts.
+    #[serde(deserialize_with = "crate::plugin::component")]
     pub environment: Box<dyn EnvironmentConfig>,
     /// Who decides.
+    #[serde(deserialize_with = "crate::plugin::component")]
     pub policy: Box<dyn PolicyConfig>,
     /// The workload model that evolves and scores the person's workload.
+    #[serde(deserialize_with = "crate::plugin::component")]
     pub workload: Box<dyn WorkloadModelConfig>,
     /// The model the policy forecasts with, if different from `workload`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::plugin::optional_component")]
     pub policy_workload: Option<Box<dyn WorkloadModelConfig>>,
     /// How queries reach the expert.
+    #[serde(deserialize_with = "crate::plugin::component")]
     pub channel: Box<dyn QueryChannelConfig>,
 }
 
@@ -156,8 +160,12 @@ impl ExperimentConfig {
         Ok(Self::parse(&text, path)?)
     }
 
-    /// Parses experiment TOML; `path` is only used in error messages.
+    /// Parses experiment TOML. `path` names the file in error messages, and
+    /// the `plugins` it lists are resolved against its directory and loaded
+    /// (see [`crate::plugin::load`]) before the components are parsed, so
+    /// plugin types are usable wherever built-in ones are.
     pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
+        load_plugins(text, path)?;
         let cfg: Self = parse_toml(text, path)?;
         cfg.session
             .validate()
@@ -172,6 +180,27 @@ impl ExperimentConfig {
         }
         Ok(cfg)
     }
+}
+
+/// Loads the `plugins` an experiment file lists, relative to its directory.
+fn load_plugins(text: &str, path: &Path) -> std::result::Result<(), ConfigError> {
+    #[derive(Deserialize)]
+    struct PluginsOnly {
+        #[serde(default)]
+        plugins: Vec<PathBuf>,
+    }
+    let pre: PluginsOnly = parse_toml(text, path)?;
+    let base = path.parent().unwrap_or(Path::new(""));
+    for p in &pre.plugins {
+        let full = if p.is_absolute() {
+            p.clone()
+        } else {
+            base.join(p)
+        };
+        crate::plugin::load(&full)
+            .map_err(|e| ConfigError::at_key(text, path, &["plugins"], e.to_string()))?;
+    }
+    Ok(())
 }
 
 /// A configuration error, located in its file.
@@ -343,6 +372,10 @@ fn find_key_line(text: &str, section: &[String], key: &str) -> Option<usize> {
 /// The literal a serde "invalid type/value" message quotes, as it would be
 /// written in TOML: `string "two"` gives `"two"`, `integer `5`` gives `5`.
 fn offending_literal(msg: &str) -> Option<String> {
+    // An unknown component type: the literal is the `type` value.
+    if let Some(r) = msg.strip_prefix("unknown variant `") {
+        return Some(format!("\"{}\"", &r[..r.find('`')?]));
+    }
     let rest = msg
         .strip_prefix("invalid type: ")
         .or_else(|| msg.strip_prefix("invalid value: "))?;

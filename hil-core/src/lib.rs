@@ -14,9 +14,13 @@
 //! - The loop: [`Session`] runs episodes with the paper's semantics and
 //!   emits one [`StepEvent`] per step; [`EpisodeMetrics`] computes the
 //!   paper's metrics from those events.
+//! - The interaction record: [`record`] logs every step durably and
+//!   resumes killed sessions.
 //! - Configs: [`config::ExperimentConfig`], with errors naming file, line and field.
+//! - Plugins: [`plugin`] loads types from shared libraries ([`declare_plugin!`]).
 //! - Conformance suites for implementers: `hil_core::testing` (feature `testing`).
-#![forbid(unsafe_code)]
+// Only the plugin loader may use `unsafe` (it allows it locally).
+#![deny(unsafe_code)]
 
 pub mod action;
 pub mod channel;
@@ -27,8 +31,10 @@ pub mod environment;
 pub mod error;
 pub mod experiment;
 pub mod metrics;
+pub mod plugin;
 pub mod policy;
 pub mod query;
+pub mod record;
 pub mod session;
 pub mod time;
 pub mod workload;

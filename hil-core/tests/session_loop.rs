@@ -4,12 +4,34 @@ use std::sync::Arc;
 
 use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, ScriptedPolicy, TableEnv};
 use hil_core::{
-    ActionSpace, Answer, ArmId, Choice, EventCollector, Query, QueryChannel, QueryKind, Response,
-    Session, SessionSettings, StepDecision,
+    ActionSpace, Answer, ArmId, Choice, EpisodeReport, EventCollector, Query, QueryChannel,
+    QueryKind, Response, Session, SessionObserver, SessionSettings, StepDecision,
 };
 
 fn actions() -> ActionSpace {
     ActionSpace::new(["A", "B", "C"]).unwrap()
+}
+
+/// Runs one episode with a counting workload model (+`inc` per query).
+fn episode(
+    env: &mut TableEnv,
+    policy: &mut ScriptedPolicy,
+    channel: &mut dyn QueryChannel,
+    settings: SessionSettings,
+    inc: f64,
+    seed: u64,
+    observers: &mut [&mut dyn SessionObserver],
+) -> EpisodeReport {
+    Session {
+        settings,
+        environment: env,
+        policy,
+        channel,
+        workload: Arc::new(CountingWorkload::new(inc)),
+        forecast: None,
+    }
+    .run_episode(seed, observers)
+    .unwrap()
 }
 
 fn act(a: usize) -> Choice {
@@ -57,19 +79,19 @@ fn hand_worked_episode() {
     );
     let mut channel = OracleChannel::default();
     let mut collector = EventCollector::default();
-    let mut session = Session {
-        settings: SessionSettings {
+    let report = episode(
+        &mut env,
+        &mut policy,
+        &mut channel,
+        SessionSettings {
             n_att: 3,
             wl0: 0.5,
             max_items: None,
         },
-        environment: &mut env,
-        policy: &mut policy,
-        channel: &mut channel,
-        workload: Arc::new(CountingWorkload::new(0.1)),
-        forecast: None,
-    };
-    let report = session.run_episode(1, &mut [&mut collector]).unwrap();
+        0.1,
+        1,
+        &mut [&mut collector],
+    );
     let ev = &report.events;
     assert_eq!(ev.len(), 7);
     assert_eq!(collector.events, report.events);
@@ -134,15 +156,15 @@ fn expert_action_is_repeated_until_success() {
         .with_outcomes(vec![false, false, false, false, true]);
     let mut policy = ScriptedPolicy::new(3, 3, vec![query(2), act(0)]);
     let mut channel = OracleChannel::default();
-    let mut session = Session {
-        settings: SessionSettings::default(),
-        environment: &mut env,
-        policy: &mut policy,
-        channel: &mut channel,
-        workload: Arc::new(CountingWorkload::new(0.1)),
-        forecast: None,
-    };
-    let r = session.run_episode(0, &mut []).unwrap();
+    let r = episode(
+        &mut env,
+        &mut policy,
+        &mut channel,
+        SessionSettings::default(),
+        0.1,
+        0,
+        &mut [],
+    );
     assert_eq!(r.events.len(), 5);
     assert!(r.events.iter().all(|e| e.step.arm == ArmId(1)));
     assert_eq!(channel.asked, 1);
@@ -164,18 +186,18 @@ fn item_ends_after_n_att_attempts() {
     let mut policy = ScriptedPolicy::new(3, 4, vec![act(0)]);
     let mut channel = OracleChannel::default();
     for n_att in [1, 4, 10] {
-        let mut session = Session {
-            settings: SessionSettings {
+        let r = episode(
+            &mut env,
+            &mut policy,
+            &mut channel,
+            SessionSettings {
                 n_att,
                 ..Default::default()
             },
-            environment: &mut env,
-            policy: &mut policy,
-            channel: &mut channel,
-            workload: Arc::new(CountingWorkload::new(0.1)),
-            forecast: None,
-        };
-        let r = session.run_episode(3, &mut []).unwrap();
+            0.1,
+            3,
+            &mut [],
+        );
         let tofu = r.events.iter().filter(|e| e.step.item_index == 0).count();
         assert_eq!(tofu as u32, n_att);
         assert_eq!(r.metrics.n_items, 2);
@@ -203,18 +225,18 @@ fn declined_query_falls_back_and_still_costs_workload() {
     let mut env = TableEnv::new(actions(), vec![("pear", vec![0.0, 0.0, 0.0])]).unwrap();
     let mut policy = ScriptedPolicy::new(3, 3, vec![query(2), act(1), query(0)]);
     let mut channel = Decliner(0);
-    let mut session = Session {
-        settings: SessionSettings {
+    let r = episode(
+        &mut env,
+        &mut policy,
+        &mut channel,
+        SessionSettings {
             n_att: 3,
             ..Default::default()
         },
-        environment: &mut env,
-        policy: &mut policy,
-        channel: &mut channel,
-        workload: Arc::new(CountingWorkload::new(0.2)),
-        forecast: None,
-    };
-    let r = session.run_episode(0, &mut []).unwrap();
+        0.2,
+        0,
+        &mut [],
+    );
     let arms: Vec<usize> = r.events.iter().map(|e| e.step.arm.0).collect();
     assert_eq!(
         arms,
@@ -240,15 +262,16 @@ fn seeded_episodes_replay_exactly() {
         .unwrap();
         let mut policy = ScriptedPolicy::new(3, 4, vec![act(0), act(1), query(2), act(2)]);
         let mut channel = OracleChannel::default();
-        let mut s = Session {
-            settings: SessionSettings::default(),
-            environment: &mut env,
-            policy: &mut policy,
-            channel: &mut channel,
-            workload: Arc::new(CountingWorkload::new(0.1)),
-            forecast: None,
-        };
-        s.run_episode(seed, &mut []).unwrap().events
+        episode(
+            &mut env,
+            &mut policy,
+            &mut channel,
+            SessionSettings::default(),
+            0.1,
+            seed,
+            &mut [],
+        )
+        .events
     };
     assert_eq!(run(5), run(5));
 }

@@ -2,4 +2,5 @@
 
 pub mod bench;
 pub mod kinova;
+pub mod plugins;
 pub mod run;

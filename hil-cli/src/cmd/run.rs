@@ -1,16 +1,29 @@
-//! `hil run --config FILE`: run an experiment config.
+//! `hil run --config FILE [--log LOG]`: run an experiment config, recording
+//! every step; `hil run --resume LOG`: continue a recorded session.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use hil_core::{ExperimentConfig, HilError, SessionObserver, StepEvent};
+use hil_core::record::{Header, RecordLog, run_recorded};
+use hil_core::{
+    EpisodeMetrics, ExperimentConfig, ExperimentSummary, HilError, SessionObserver, StepEvent,
+};
 
 /// Arguments of `hil run`.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
     /// The experiment file (TOML).
-    #[arg(long, short)]
-    pub config: PathBuf,
+    #[arg(long, short, required_unless_present = "resume")]
+    pub config: Option<PathBuf>,
+    /// Record every step in this interaction log (JSONL; each step is on
+    /// disk before the robot acts). The file must not exist yet.
+    #[arg(long, value_name = "LOG")]
+    pub log: Option<PathBuf>,
+    /// Continue the session recorded in LOG (after a crash, a kill or an
+    /// interrupt): the config comes from the log, answered queries are not
+    /// asked again, and new steps are appended to LOG.
+    #[arg(long, value_name = "LOG", conflicts_with_all = ["config", "log"])]
+    pub resume: Option<PathBuf>,
     /// Write every step event to this JSONL file.
     #[arg(long)]
     pub events: Option<PathBuf>,
@@ -38,14 +51,30 @@ impl SessionObserver for JsonlEvents {
     }
 }
 
+/// The session to run: a fresh one from a config, or a logged one to resume.
+enum Start {
+    Fresh {
+        config: PathBuf,
+        log: Option<PathBuf>,
+    },
+    Resume(PathBuf),
+}
+
 pub fn run(args: RunArgs) -> hil_core::Result<()> {
-    let cfg = ExperimentConfig::load(&args.config)?;
-    let base = args
-        .config
-        .parent()
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("."));
-    let mut exp = cfg.build(&base)?;
+    let start = match (&args.resume, &args.config) {
+        (Some(log), _) => Start::Resume(log.clone()),
+        (None, Some(config)) => Start::Fresh {
+            config: config.clone(),
+            log: args.log.clone(),
+        },
+        (None, None) => {
+            return Err(HilError::invalid_input(
+                "arguments",
+                "give --config FILE, or --resume LOG",
+            ));
+        }
+    };
+    let quiet = args.quiet || args.json;
     let mut sink = match &args.events {
         Some(p) => Some(JsonlEvents {
             path: p.clone(),
@@ -59,27 +88,126 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
     if let Some(s) = sink.as_mut() {
         observers.push(s);
     }
-    let quiet = args.quiet || args.json;
-    let summary = exp.run(&mut observers, |k, r| {
+    let progress = |k: usize, m: &EpisodeMetrics| {
         if !quiet {
-            let m = &r.metrics;
             eprintln!(
                 "episode {k}: items {} steps {} r_task_avg {:.3} ΔWL {:+.3} f_q {:.3} n_q {} n_success {}",
                 m.n_items, m.n_steps, m.r_task_avg, m.delta_wl, m.f_q, m.n_q, m.n_success
             );
         }
-    })?;
+    };
+
+    install_interrupt_notice(match &start {
+        Start::Fresh { log, .. } => log.clone(),
+        Start::Resume(log) => Some(log.clone()),
+    });
+    let summary = match start {
+        Start::Fresh { config, log } => {
+            let text = std::fs::read_to_string(&config)
+                .map_err(|e| HilError::io("reading", &config, e))?;
+            let cfg = ExperimentConfig::parse(&text, &config)?;
+            // Absolute, so that a resume from another directory finds the
+            // same files.
+            let base = absolute(config.parent().unwrap_or(Path::new(".")))?;
+            let mut exp = cfg.build(&base)?;
+            announce_endpoint(exp.channel.endpoint());
+            match log {
+                Some(log_path) => {
+                    let header =
+                        Header::new(&text, absolute(&config)?, base, exp.seed, exp.episodes);
+                    let log = RecordLog::create(&log_path, header)?;
+                    if !quiet {
+                        eprintln!("recording to {}", log_path.display());
+                    }
+                    run_recorded(&mut exp, log, None, &mut observers, progress)?
+                }
+                None => exp.run(&mut observers, |k, r| progress(k, &r.metrics))?,
+            }
+        }
+        Start::Resume(log_path) => {
+            let (log, logged) = RecordLog::open(&log_path)?;
+            let header = &logged.header;
+            let cfg = ExperimentConfig::parse(&header.config, &header.config_path)?;
+            let mut exp = cfg.build(&header.base_dir)?;
+            if !quiet {
+                eprintln!(
+                    "resuming {} ({} records{})",
+                    log_path.display(),
+                    logged.records.len() + 1,
+                    if logged.truncated_bytes > 0 {
+                        format!(
+                            "; discarded an incomplete last line of {} bytes",
+                            logged.truncated_bytes
+                        )
+                    } else {
+                        String::new()
+                    }
+                );
+            }
+            announce_endpoint(exp.channel.endpoint());
+            run_recorded(&mut exp, log, Some(&logged), &mut observers, progress)?
+        }
+    };
+    drop(observers);
     if let Some(mut s) = sink {
         s.out
             .flush()
             .map_err(|e| HilError::io("writing", &s.path, e))?;
     }
-    if args.json {
+    print_summary(&summary, args.json, args.quiet)
+}
+
+/// On Ctrl-C (or SIGTERM), says what was kept and how to continue, then
+/// exits with status 130. Every step answered so far is already on disk
+/// (steps are fsync'ed before the robot acts); a line cut short by the
+/// interrupt is discarded by `--resume`.
+#[cfg(unix)]
+fn install_interrupt_notice(log: Option<PathBuf>) {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+        return; // the default behaviour (ending the process) still applies
+    };
+    let _ = std::thread::Builder::new()
+        .name("hil-interrupt".into())
+        .spawn(move || {
+            if signals.forever().next().is_some() {
+                match &log {
+                    Some(p) => eprintln!(
+                        "\ninterrupted: every answered step is in {0}; continue with `hil run --resume {0}`",
+                        p.display()
+                    ),
+                    None => eprintln!(
+                        "\ninterrupted: no interaction log was kept (run with --log LOG to be able to resume)"
+                    ),
+                }
+                std::process::exit(130);
+            }
+        });
+}
+
+#[cfg(not(unix))]
+fn install_interrupt_notice(_log: Option<PathBuf>) {}
+
+/// Tells the researcher where the person answers (a web channel's URL).
+/// Printed even with --quiet: without it nobody can answer.
+fn announce_endpoint(endpoint: Option<String>) {
+    if let Some(url) = endpoint {
+        eprintln!("open this address on the phone or tablet to answer the robot's questions:");
+        eprintln!("  {url}");
+    }
+}
+
+fn absolute(path: &Path) -> hil_core::Result<PathBuf> {
+    std::path::absolute(path).map_err(|e| HilError::io("resolving", path, e))
+}
+
+fn print_summary(summary: &ExperimentSummary, json: bool, quiet: bool) -> hil_core::Result<()> {
+    if json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&summary).map_err(|e| HilError::serde("summary", e))?
+            serde_json::to_string_pretty(summary).map_err(|e| HilError::serde("summary", e))?
         );
-    } else if !args.quiet {
+    } else if !quiet {
         println!(
             "{} episode(s): r_task_avg {:.3} ± {:.3}, ΔWL {:+.3} ± {:.3}, f_q {:.3} ± {:.3}, t_conv {:.2} ± {:.2}",
             summary.episodes.len(),

@@ -10,8 +10,10 @@
 //! [`fixtures`] has small, real implementations of every trait for tests of
 //! code that consumes the traits (session loop, logs, metrics), and
 //! [`strategies`] has proptest strategies (contexts, query histories,
-//! positive-definite matrices).
+//! positive-definite matrices), and [`cdylib`] builds plugin libraries
+//! from tests.
 
+pub mod cdylib;
 pub mod fixtures;
 pub mod strategies;
 

@@ -31,35 +31,18 @@ pub fn check_policy(
     b.seed(42);
     let model = CountingWorkload::new(0.1);
     let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let mut history = QueryHistory::new();
-    let mut state = DriveState::default();
-    for _ in 0..40 {
-        let x = random_context(&mut rng, dim);
-        let reward = f64::from(rng.random_bool(0.5));
-        let da = drive(
-            &mut c,
-            a.as_mut(),
-            &x,
-            &model,
-            &mut history,
-            &mut state,
-            reward,
-            false,
-        )?;
-        let db = drive(
-            &mut c,
-            b.as_mut(),
-            &x,
-            &model,
-            &mut history,
-            &mut state,
-            reward,
-            true,
-        )?;
-        c.check("determinism", da == db, || {
-            format!("same seed, same inputs, different decisions: {da:?} vs {db:?}")
-        })?;
-    }
+    let mut twin_a = Twin::default();
+    let mut twin_b = Twin::default();
+    lockstep(
+        &mut c,
+        "determinism",
+        (a.as_mut(), &mut twin_a),
+        (b.as_mut(), &mut twin_b),
+        &model,
+        &mut rng,
+        40,
+    )?;
+    let (history, state) = (&twin_a.history, &twin_a.state);
 
     // Bad input.
     let wrong = Context::new(vec![0.5; dim + 1]).expect("finite");
@@ -69,7 +52,7 @@ pub fn check_policy(
         item_index: state.item,
         items_seen: state.item,
         attempt: 0,
-        workload: WorkloadForecast::new(Some(&model), 0.5, &history, state.t + 1),
+        workload: WorkloadForecast::new(Some(&model), 0.5, history, state.t + 1),
     };
     c.check("rejects wrong dimension", a.decide(&input).is_err(), || {
         format!(
@@ -106,35 +89,16 @@ pub fn check_policy(
             let mut r = c.ok("checkpoint", make())?;
             r.seed(1234); // the restored RNG state must override this
             c.ok("checkpoint", r.restore(state_json))?;
-            let mut h2 = history.clone();
-            let mut s2 = state.clone();
-            for _ in 0..20 {
-                let x = random_context(&mut rng, dim);
-                let reward = f64::from(rng.random_bool(0.5));
-                let da = drive(
-                    &mut c,
-                    a.as_mut(),
-                    &x,
-                    &model,
-                    &mut history,
-                    &mut state,
-                    reward,
-                    true,
-                )?;
-                let dr = drive(
-                    &mut c,
-                    r.as_mut(),
-                    &x,
-                    &model,
-                    &mut h2,
-                    &mut s2,
-                    reward,
-                    true,
-                )?;
-                c.check("checkpoint", da == dr, || {
-                    format!("restored policy diverged: {da:?} vs {dr:?}")
-                })?;
-            }
+            let mut twin_r = twin_a.clone();
+            lockstep(
+                &mut c,
+                "checkpoint",
+                (a.as_mut(), &mut twin_a),
+                (r.as_mut(), &mut twin_r),
+                &model,
+                &mut rng,
+                20,
+            )?;
         }
     }
     Ok(c.finish())
@@ -146,6 +110,54 @@ fn fail_build(why: String) -> ConformanceFailure {
         check: "build",
         detail: why,
     }
+}
+
+/// Drives two policies with identical inputs and checks they decide alike.
+fn lockstep(
+    c: &mut Checker,
+    check: &'static str,
+    (a, ta): (&mut dyn Policy, &mut Twin),
+    (b, tb): (&mut dyn Policy, &mut Twin),
+    model: &dyn WorkloadModel,
+    rng: &mut ChaCha8Rng,
+    steps: usize,
+) -> Result<(), ConformanceFailure> {
+    for _ in 0..steps {
+        let dim = a.dim();
+        let x = random_context(rng, dim);
+        let reward = f64::from(rng.random_bool(0.5));
+        let da = drive(
+            c,
+            a,
+            &x,
+            model,
+            &mut ta.history,
+            &mut ta.state,
+            reward,
+            true,
+        )?;
+        let db = drive(
+            c,
+            b,
+            &x,
+            model,
+            &mut tb.history,
+            &mut tb.state,
+            reward,
+            true,
+        )?;
+        c.check(check, da == db, || {
+            format!("same inputs, different decisions: {da:?} vs {db:?}")
+        })?;
+    }
+    Ok(())
+}
+
+/// The inputs one policy of a lockstep pair has seen.
+#[derive(Clone, Default)]
+struct Twin {
+    history: QueryHistory,
+    state: DriveState,
 }
 
 #[derive(Clone, Default)]

@@ -1,0 +1,31 @@
+//! # hil-channels
+//!
+//! How a query reaches a person and comes back, for **hil**:
+//!
+//! - [`SimulatedExpert`]: the paper's perfect expert, or an imperfect one
+//!   with an error rate, a decline rate and a response-time model
+//!   (`type = "simulated_expert"`).
+//! - [`TerminalChannel`]: an interactive prompt for researchers at a
+//!   terminal (`type = "terminal"`).
+//! - [`WebChannel`]: a page served on 127.0.0.1 for the person being fed,
+//!   on a phone or tablet, by touch, keyboard or single switch
+//!   (`type = "web"`).
+//! - [`demo`]: a small plate of foods and a simple learner, to try the
+//!   channels without a robot (`demo_plate`, `demo_learner`).
+//!
+//! Every channel passes `hil_core::testing::check_query_channel` (the human
+//! ones with a scripted person at the other end, in their tests).
+
+pub mod demo;
+pub mod present;
+pub mod simulated;
+pub mod terminal;
+pub mod web;
+
+pub use simulated::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
+pub use terminal::{TerminalChannel, TerminalChannelConfig};
+pub use web::{WebChannel, WebChannelConfig};
+
+/// Does nothing; calling it keeps this crate (and its typetag registrations)
+/// linked into a binary that names its components only in configs.
+pub fn link() {}

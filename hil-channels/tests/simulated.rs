@@ -1,0 +1,217 @@
+//! Simulated experts and the demo components: conformance, rates, seeding
+//! and configs.
+
+use hil_channels::demo::{DemoLearner, DemoLearnerConfig, DemoPlate};
+use hil_channels::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
+use hil_core::config::QueryChannelConfig;
+use hil_core::testing::{check_environment, check_policy, check_query_channel};
+use hil_core::{
+    ActionSpace, Answer, ArmId, BuildContext, Context, Item, Query, QueryChannel, QueryKind,
+    ResponseType,
+};
+
+fn query(t: u64, best: usize, response: ResponseType) -> Query {
+    Query {
+        t,
+        item: Item {
+            index: 0,
+            label: "carrot".into(),
+            description: None,
+        },
+        kind: QueryKind {
+            response,
+            ..Default::default()
+        },
+        actions: ActionSpace::feeding(),
+        context: Context::new(vec![1.0, 0.0]).unwrap(),
+        oracle_best: Some(ArmId(best)),
+    }
+}
+
+fn expert(error_rate: f64, decline_rate: f64) -> SimulatedExpert {
+    SimulatedExpert::new(SimulatedExpertConfig {
+        error_rate,
+        decline_rate,
+        response_time: Some(ResponseTimeModel {
+            median_s: 4.0,
+            sigma: 0.5,
+        }),
+    })
+    .unwrap()
+}
+
+#[test]
+fn perfect_and_imperfect_experts_conform() {
+    check_query_channel(&mut SimulatedExpert::perfect(), 36).unwrap();
+    check_query_channel(&mut expert(0.3, 0.2), 36).unwrap();
+    check_query_channel(&mut expert(1.0, 0.0), 36).unwrap();
+}
+
+#[test]
+fn perfect_expert_always_answers_the_best_action() {
+    let mut e = SimulatedExpert::perfect();
+    for t in 1..50 {
+        let best = (t as usize * 7) % 6;
+        for rt in ResponseType::ALL {
+            let r = e.ask(&query(t, best, rt)).unwrap();
+            assert_eq!(r.expert_arm, Some(ArmId(best)));
+            assert_eq!(r.response_time_s, None);
+            match (rt, &r.answer) {
+                (ResponseType::Mcq, Answer::Action { arm }) => assert_eq!(*arm, ArmId(best)),
+                (ResponseType::BoundingBox, Answer::BoundingBox { bbox }) => {
+                    assert!(0.0 <= bbox.x0 && bbox.x0 < bbox.x1 && bbox.x1 <= 1.0)
+                }
+                (ResponseType::OpenEnded, Answer::Text { text }) => {
+                    assert!(text.contains(hil_core::FEEDING_ACTIONS[best]))
+                }
+                other => panic!("unexpected answer {other:?}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn error_and_decline_rates_are_honoured() {
+    let mut e = expert(0.3, 0.2);
+    e.seed(11);
+    let n = 4000;
+    let (mut declined, mut wrong, mut answered) = (0, 0, 0);
+    let mut times = Vec::new();
+    for t in 1..=n {
+        let r = e.ask(&query(t, 2, ResponseType::Mcq)).unwrap();
+        times.push(r.response_time_s.unwrap());
+        match r.answer {
+            Answer::Declined => {
+                declined += 1;
+                assert_eq!(r.expert_arm, None);
+            }
+            Answer::Action { arm } => {
+                answered += 1;
+                if arm != ArmId(2) {
+                    wrong += 1;
+                }
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+    // Seeded, so exact counts are reproducible; these bounds are ±5 standard deviations.
+    let decline_frac = declined as f64 / n as f64;
+    let wrong_frac = wrong as f64 / answered as f64;
+    assert!((decline_frac - 0.2).abs() < 0.035, "{decline_frac}");
+    assert!((wrong_frac - 0.3).abs() < 0.04, "{wrong_frac}");
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    assert!((median - 4.0).abs() < 0.3, "median response time {median}");
+}
+
+#[test]
+fn wrong_answers_are_spread_over_the_other_arms() {
+    let mut e = expert(1.0, 0.0);
+    let mut seen = [0usize; 6];
+    for t in 1..=600 {
+        let r = e.ask(&query(t, 3, ResponseType::Mcq)).unwrap();
+        seen[r.expert_arm.unwrap().0] += 1;
+    }
+    assert_eq!(seen[3], 0);
+    assert!(
+        seen.iter().enumerate().all(|(i, c)| i == 3 || *c > 60),
+        "{seen:?}"
+    );
+}
+
+#[test]
+fn seeded_answers_are_reproducible_and_independent_of_skipped_queries() {
+    let mut a = expert(0.4, 0.3);
+    let mut b = expert(0.4, 0.3);
+    a.seed(99);
+    b.seed(99);
+    let all: Vec<_> = (1..=40)
+        .map(|t| a.ask(&query(t, 1, ResponseType::Mcq)).unwrap())
+        .collect();
+    // b skips every other query (as a resumed session replays them from the
+    // record): the answers it does give are unchanged.
+    for t in (2..=40).step_by(2) {
+        assert_eq!(
+            b.ask(&query(t, 1, ResponseType::Mcq)).unwrap(),
+            all[t as usize - 1]
+        );
+    }
+    let mut c = expert(0.4, 0.3);
+    c.seed(100);
+    let other: Vec<_> = (1..=40)
+        .map(|t| c.ask(&query(t, 1, ResponseType::Mcq)).unwrap())
+        .collect();
+    assert_ne!(all, other);
+}
+
+#[test]
+fn missing_oracle_is_a_clear_error() {
+    let mut q = query(1, 0, ResponseType::Mcq);
+    q.oracle_best = None;
+    let err = SimulatedExpert::perfect().ask(&q).unwrap_err().to_string();
+    assert!(err.contains("best action"), "{err}");
+}
+
+#[derive(serde::Deserialize)]
+struct Doc {
+    channel: Box<dyn QueryChannelConfig>,
+}
+
+#[test]
+fn config_parses_validates_and_rejects_unknown_fields() {
+    let ctx = BuildContext::new(".", 0);
+    let ok: Doc = toml::from_str(
+        "[channel]\ntype = \"simulated_expert\"\nerror_rate = 0.1\ndecline_rate = 0.05\nresponse_time = { median_s = 3.0, sigma = 0.2 }\n",
+    )
+    .unwrap();
+    check_query_channel(ok.channel.build(&ctx).unwrap().as_mut(), 12).unwrap();
+
+    let bad: Doc =
+        toml::from_str("[channel]\ntype = \"simulated_expert\"\nerror_rate = 1.5\n").unwrap();
+    let err = bad.channel.build(&ctx).err().unwrap().to_string();
+    assert!(err.contains("error_rate") && err.contains("1.5"), "{err}");
+
+    let bad: Doc = toml::from_str(
+        "[channel]\ntype = \"simulated_expert\"\nresponse_time = { median_s = -1.0 }\n",
+    )
+    .unwrap();
+    let err = bad.channel.build(&ctx).err().unwrap().to_string();
+    assert!(err.contains("median_s"), "{err}");
+
+    let unknown =
+        toml::from_str::<Doc>("[channel]\ntype = \"simulated_expert\"\neror_rate = 0.1\n");
+    let err = unknown.err().unwrap().to_string();
+    assert!(err.contains("eror_rate"), "{err}");
+}
+
+#[test]
+fn demo_components_conform() {
+    check_environment(
+        &|| {
+            Ok(Box::new(DemoPlate::new(
+                &["banana".into(), "carrot".into(), "grape".into()],
+                2,
+            )?))
+        },
+        4,
+    )
+    .unwrap();
+    check_policy(&|| {
+        Ok(Box::new(DemoLearner::new(
+            6,
+            5,
+            DemoLearnerConfig {
+                query_probability: 0.4,
+                epsilon: 0.2,
+                kinds: vec![],
+            },
+        )))
+    })
+    .unwrap();
+    assert!(DemoPlate::new(&["pizza".into()], 1).is_err());
+    hil_core::testing::check_workload_model(&hil_channels::demo::DemoCounting {
+        increment: 0.05,
+        window: 10,
+    })
+    .unwrap();
+}

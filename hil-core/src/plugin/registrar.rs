@@ -1,0 +1,294 @@
+//! How a plugin hands its factories to the host.
+//!
+//! The host implements [`PluginRegistrar`]; the plugin only ever sees it
+//! through [`Registrar`], whose methods wrap every factory and every object a
+//! factory returns in the panic guards of [`super::guard`]. Those wrappers
+//! are generic over the plugin's closures, so they are compiled into the
+//! plugin, on the plugin's side of the boundary, with the plugin's copy of
+//! the standard library: a panic is caught where it can be caught.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use serde::de::DeserializeOwned;
+
+use super::guard::{self, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload};
+use crate::config::BuildContext;
+use crate::error::{HilError, Result};
+use crate::{Environment, Policy, QueryChannel, WorkloadModel};
+
+/// The four kinds of component a plugin can provide.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ComponentKind {
+    /// A [`Policy`].
+    Policy,
+    /// An [`Environment`].
+    Environment,
+    /// A [`WorkloadModel`].
+    WorkloadModel,
+    /// A [`QueryChannel`].
+    QueryChannel,
+}
+
+impl ComponentKind {
+    /// All kinds.
+    pub const ALL: [Self; 4] = [
+        Self::Policy,
+        Self::Environment,
+        Self::WorkloadModel,
+        Self::QueryChannel,
+    ];
+
+    /// Lower-case name, as in messages and `hil plugins list`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Policy => "policy",
+            Self::Environment => "environment",
+            Self::WorkloadModel => "workload model",
+            Self::QueryChannel => "query channel",
+        }
+    }
+}
+
+impl std::fmt::Display for ComponentKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// The format of a [`Params`] text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamFormat {
+    /// A TOML table (the body of a config section).
+    Toml,
+    /// A JSON object.
+    Json,
+}
+
+/// A factory's parameters: a TOML or JSON text. Plain text crosses the
+/// plugin boundary where typetag's registry cannot.
+///
+/// ```
+/// use hil_core::plugin::Params;
+/// #[derive(serde::Deserialize)]
+/// struct P { alpha: f64 }
+/// let p: P = Params::toml("alpha = 0.5").parse("my_policy").unwrap();
+/// assert_eq!(p.alpha, 0.5);
+/// let p: P = Params::json(r#"{"alpha": 2.0}"#).parse("my_policy").unwrap();
+/// assert_eq!(p.alpha, 2.0);
+/// assert!(Params::json("{}").parse::<P>("my_policy").is_err());
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Params {
+    text: String,
+    format: ParamFormat,
+}
+
+impl Params {
+    /// TOML parameters (an empty text is an empty table).
+    pub fn toml(text: impl Into<String>) -> Self {
+        Self {
+            text: text.into(),
+            format: ParamFormat::Toml,
+        }
+    }
+
+    /// JSON parameters (an empty text is an empty object).
+    pub fn json(text: impl Into<String>) -> Self {
+        Self {
+            text: text.into(),
+            format: ParamFormat::Json,
+        }
+    }
+
+    /// No parameters: an empty table.
+    pub fn empty() -> Self {
+        Self::toml("")
+    }
+
+    /// The raw text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The format of the text.
+    pub fn format(&self) -> ParamFormat {
+        self.format
+    }
+
+    /// Deserialises the parameters of the type registered as `type_name`.
+    /// Errors name the type and say what is wrong (unknown or missing field,
+    /// bad value), as a [`HilError::Serde`].
+    pub fn parse<T: DeserializeOwned>(&self, type_name: &str) -> Result<T> {
+        let what = || format!("parameters of `{type_name}`");
+        match self.format {
+            ParamFormat::Toml => {
+                toml::from_str(&self.text).map_err(|e| HilError::serde(what(), e.message().trim()))
+            }
+            ParamFormat::Json => {
+                let text = if self.text.trim().is_empty() {
+                    "{}"
+                } else {
+                    &self.text
+                };
+                serde_json::from_str(text).map_err(|e| HilError::serde(what(), e))
+            }
+        }
+    }
+}
+
+/// Builds a policy from parameters and the experiment's build context.
+pub type PolicyFactory =
+    Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<dyn Policy>> + Send + Sync>;
+/// Builds an environment.
+pub type EnvironmentFactory =
+    Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<dyn Environment>> + Send + Sync>;
+/// Builds a workload model.
+pub type WorkloadModelFactory =
+    Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<dyn WorkloadModel>> + Send + Sync>;
+/// Builds a query channel.
+pub type QueryChannelFactory =
+    Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<dyn QueryChannel>> + Send + Sync>;
+
+/// A factory of any kind.
+#[derive(Clone)]
+pub enum Factory {
+    /// Builds policies.
+    Policy(PolicyFactory),
+    /// Builds environments.
+    Environment(EnvironmentFactory),
+    /// Builds workload models.
+    WorkloadModel(WorkloadModelFactory),
+    /// Builds query channels.
+    QueryChannel(QueryChannelFactory),
+}
+
+impl Factory {
+    /// The kind of component it builds.
+    pub fn kind(&self) -> ComponentKind {
+        match self {
+            Self::Policy(_) => ComponentKind::Policy,
+            Self::Environment(_) => ComponentKind::Environment,
+            Self::WorkloadModel(_) => ComponentKind::WorkloadModel,
+            Self::QueryChannel(_) => ComponentKind::QueryChannel,
+        }
+    }
+}
+
+impl std::fmt::Debug for Factory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Factory({})", self.kind())
+    }
+}
+
+/// The host's side of registration. Implemented by the host; plugins use
+/// [`Registrar`], which guards what it passes on.
+pub trait PluginRegistrar {
+    /// The library being registered (for messages).
+    fn library(&self) -> &Path;
+
+    /// Adds a named factory. Problems (a duplicate or invalid name) are
+    /// collected by the host and refuse the whole library after `register`.
+    fn add(&mut self, name: &str, description: &str, factory: Factory);
+}
+
+/// What a plugin's registration function receives: registers named,
+/// panic-guarded factories for any of the four traits.
+///
+/// ```
+/// use hil_core::plugin::{Params, Registrar};
+/// use hil_core::testing::fixtures::CountingWorkload;
+/// fn register(r: &mut Registrar<'_>) {
+///     r.workload_model("counting_demo", "WL_0 plus a fixed step per query", |p: &Params, _ctx| {
+///         #[derive(serde::Deserialize)]
+///         struct P { step: f64 }
+///         let p: P = p.parse("counting_demo")?;
+///         Ok(Box::new(CountingWorkload::new(p.step)))
+///     });
+/// }
+/// # let _ = register;
+/// ```
+pub struct Registrar<'a> {
+    host: &'a mut dyn PluginRegistrar,
+    library: PathBuf,
+}
+
+impl std::fmt::Debug for Registrar<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Registrar")
+            .field("library", &self.library)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'a> Registrar<'a> {
+    /// Wraps the host's registrar.
+    pub fn new(host: &'a mut dyn PluginRegistrar) -> Self {
+        let library = host.library().to_path_buf();
+        Self { host, library }
+    }
+
+    /// Registers a policy factory under `name`.
+    pub fn policy<F>(&mut self, name: &str, description: &str, factory: F)
+    where
+        F: Fn(&Params, &BuildContext) -> Result<Box<dyn Policy>> + Send + Sync + 'static,
+    {
+        let (lib, n) = (self.library.clone(), name.to_string());
+        let f: PolicyFactory = Arc::new(move |p, ctx| {
+            let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
+            Ok(Box::new(GuardedPolicy::new(inner, lib.clone(), &n)?) as Box<dyn Policy>)
+        });
+        self.host.add(name, description, Factory::Policy(f));
+    }
+
+    /// Registers an environment factory under `name`.
+    pub fn environment<F>(&mut self, name: &str, description: &str, factory: F)
+    where
+        F: Fn(&Params, &BuildContext) -> Result<Box<dyn Environment>> + Send + Sync + 'static,
+    {
+        let (lib, n) = (self.library.clone(), name.to_string());
+        let f: EnvironmentFactory = Arc::new(move |p, ctx| {
+            let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
+            Ok(Box::new(GuardedEnvironment::new(inner, lib.clone(), &n)?) as Box<dyn Environment>)
+        });
+        self.host.add(name, description, Factory::Environment(f));
+    }
+
+    /// Registers a workload-model factory under `name`.
+    pub fn workload_model<F>(&mut self, name: &str, description: &str, factory: F)
+    where
+        F: Fn(&Params, &BuildContext) -> Result<Box<dyn WorkloadModel>> + Send + Sync + 'static,
+    {
+        let (lib, n) = (self.library.clone(), name.to_string());
+        let f: WorkloadModelFactory = Arc::new(move |p, ctx| {
+            let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
+            Ok(Box::new(GuardedWorkload::new(inner, lib.clone(), &n)?) as Box<dyn WorkloadModel>)
+        });
+        self.host.add(name, description, Factory::WorkloadModel(f));
+    }
+
+    /// Registers a query-channel factory under `name`.
+    pub fn query_channel<F>(&mut self, name: &str, description: &str, factory: F)
+    where
+        F: Fn(&Params, &BuildContext) -> Result<Box<dyn QueryChannel>> + Send + Sync + 'static,
+    {
+        let (lib, n) = (self.library.clone(), name.to_string());
+        let f: QueryChannelFactory = Arc::new(move |p, ctx| {
+            let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
+            Ok(Box::new(GuardedChannel::new(inner, lib.clone(), &n)?) as Box<dyn QueryChannel>)
+        });
+        self.host.add(name, description, Factory::QueryChannel(f));
+    }
+}
+
+/// Runs a plugin's registration function under a panic guard. Called by the
+/// code [`crate::declare_plugin!`] generates, inside the plugin.
+#[doc(hidden)]
+pub fn run_register(
+    host: &mut dyn PluginRegistrar,
+    register: impl FnOnce(&mut Registrar<'_>),
+) -> std::result::Result<(), String> {
+    let mut r = Registrar::new(host);
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| register(&mut r)))
+        .map_err(|p| guard::panic_message(p.as_ref()))
+}

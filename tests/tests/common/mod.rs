@@ -1,0 +1,47 @@
+//! The plugin crates the tests load, built once per test process.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
+
+/// Every plugin crate the integration tests load.
+pub const PLUGIN_CRATES: [&str; 9] = [
+    "hil-example-policy-thompson",
+    "hil-example-workload-fatigue",
+    "hil-example-channel-noisy-expert",
+    "hil-example-env-grasp",
+    "hil-example-plugin-guide",
+    "hil-test-plugin-panicky",
+    "hil-test-plugin-mismatched-abi",
+    "hil-test-plugin-mismatched-version",
+    "hil-test-plugin-not-a-plugin",
+];
+
+/// The workspace root.
+pub fn workspace_root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ sits in the workspace root")
+}
+
+/// The directory of the built libraries (built on first use).
+pub fn plugin_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| build_cdylibs(workspace_root(), &PLUGIN_CRATES).unwrap())
+}
+
+/// The library built from crate `krate` (e.g. `hil-example-env-grasp`).
+pub fn lib(krate: &str) -> PathBuf {
+    cdylib_path(plugin_dir(), krate)
+}
+
+/// A fresh scratch directory for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hil-plugin-tests-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}

@@ -28,6 +28,8 @@ enum Command {
     Kinova(cmd::kinova::KinovaArgs),
     /// Benchmark components (e.g. `hil bench policy --policy linucb_qg`).
     Bench(cmd::bench::BenchArgs),
+    /// Workload study data and models: generate, select, fit, rollout, bundle.
+    Workload(cmd::workload::WorkloadArgs),
     /// Inspect plugin libraries and check their types for conformance.
     Plugins(cmd::plugins::PluginsArgs),
 }
@@ -46,6 +48,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => cmd::kinova::demo(args),
         Command::Kinova(args) => cmd::kinova::kinova(args),
         Command::Bench(args) => cmd::bench::run(args),
+        Command::Workload(args) => cmd::workload::run(args),
         Command::Plugins(args) => cmd::plugins::run(args),
     };
     match result {

@@ -4,3 +4,4 @@ pub mod bench;
 pub mod kinova;
 pub mod plugins;
 pub mod run;
+pub mod workload;

@@ -1,0 +1,482 @@
+//! `hil workload …`: generate study data, select and fit workload models,
+//! roll a model out over a query schedule, regenerate the bundled models.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use hil_core::{
+    Difficulty, Distraction, HilError, QueryHistory, QueryKind, ResponseType, Result, Timestep,
+    WorkloadModel,
+};
+use hil_workload::bundle::{StudySummary, build_bundle, bundled_study};
+use hil_workload::datasets::{Dataset, DatasetId};
+use hil_workload::models::{FittedModel, Provenance};
+use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_on_all};
+use hil_workload::study::Study;
+use hil_workload::synth::SynthConfig;
+
+/// Arguments of `hil workload`.
+#[derive(Debug, clap::Args)]
+pub struct WorkloadArgs {
+    #[command(subcommand)]
+    command: WorkloadCommand,
+}
+
+#[derive(Debug, clap::Subcommand)]
+enum WorkloadCommand {
+    /// Generate a synthetic study CSV (the paper's design, calibrated to its figures).
+    Generate {
+        /// Output CSV.
+        #[arg(long)]
+        out: PathBuf,
+        /// Random seed.
+        #[arg(long, default_value_t = hil_workload::bundle::STUDY_SEED)]
+        seed: u64,
+        /// Generator settings as JSON (a `SynthConfig`; default: the calibrated one).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Print nothing.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Print a study's headline figures (pairs, WL mean ± sd, Mann-Whitney D1 < D2).
+    Summary {
+        /// Study CSV.
+        #[arg(long)]
+        data: PathBuf,
+    },
+    /// Cross-validate every model on D1, D2, D12 and write the selection table.
+    Select {
+        /// Study CSV.
+        #[arg(long)]
+        data: PathBuf,
+        /// Output directory (selection.md, selection.csv, selection.json).
+        #[arg(long)]
+        out: PathBuf,
+        #[command(flatten)]
+        cv: CvArgs,
+        /// Print only the timing line.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Fit one model on one dataset and write it as JSON.
+    Fit {
+        /// Study CSV.
+        #[arg(long)]
+        data: PathBuf,
+        /// Dataset: d1, d2 or d12.
+        #[arg(long)]
+        population: String,
+        /// constant, average, exp_impulse, granger, granger_n, granger_r, granger_rn, granger_sim.
+        #[arg(long)]
+        model: String,
+        /// History length H (Granger models).
+        #[arg(long)]
+        history: Option<usize>,
+        /// Output JSON.
+        #[arg(long)]
+        out: PathBuf,
+        /// Name stored in the file (default: derived from the model).
+        #[arg(long)]
+        name: Option<String>,
+        #[command(flatten)]
+        cv: CvArgs,
+    },
+    /// Print (and optionally plot) WL_t of a model over a query schedule.
+    Rollout {
+        /// Model JSON, or `bundled:NAME` (f1_sim, f2_sim, f12_sim, f1_real, f12_real).
+        #[arg(long)]
+        model: String,
+        /// Queries as `t:response/difficulty/distraction,...`, e.g.
+        /// `3:mcq/easy/none,9:open_ended/hard/easy` (t in 10 s timesteps;
+        /// omitted parts default to mcq/easy/none).
+        #[arg(long, default_value = "")]
+        schedule: String,
+        /// Initial workload WL_0.
+        #[arg(long, default_value_t = hil_core::workload::DEFAULT_WL0)]
+        wl0: f64,
+        /// Last timestep (default: last query + 10).
+        #[arg(long)]
+        steps: Option<Timestep>,
+        /// Write an SVG plot here.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+    },
+    /// Regenerate the bundled study and models (run from the workspace root).
+    Bundle {
+        /// The hil-workload crate directory.
+        #[arg(long, default_value = "hil-workload")]
+        dir: PathBuf,
+        #[command(flatten)]
+        cv: CvArgs,
+    },
+}
+
+#[derive(Debug, clap::Args)]
+struct CvArgs {
+    /// Seed of the fold assignment.
+    #[arg(long = "cv-seed", default_value_t = 0)]
+    cv_seed: u64,
+    /// Worker threads (0 = all cores).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+}
+
+impl CvArgs {
+    fn options(&self) -> SelectOptions {
+        SelectOptions {
+            seed: self.cv_seed,
+            threads: self.threads,
+            ..SelectOptions::default()
+        }
+    }
+}
+
+fn write(path: &Path, text: &str) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| HilError::io("creating", dir, e))?;
+    }
+    std::fs::write(path, text).map_err(|e| HilError::io("writing", path, e))
+}
+
+const SYNTHETIC: &str = "Data: synthetic study calibrated to the paper's published figures (not real participant data).";
+
+/// Runs `hil workload`.
+pub fn run(args: WorkloadArgs) -> Result<()> {
+    match args.command {
+        WorkloadCommand::Generate {
+            out,
+            seed,
+            config,
+            quiet,
+        } => {
+            let cfg = match config {
+                Some(path) => {
+                    let text = std::fs::read_to_string(&path)
+                        .map_err(|e| HilError::io("reading", &path, e))?;
+                    serde_json::from_str::<SynthConfig>(&text).map_err(|e| HilError::Data {
+                        path: path.clone(),
+                        record: e.line(),
+                        field: "(json)".into(),
+                        why: e.to_string(),
+                    })?
+                }
+                None => SynthConfig::default(),
+            };
+            let study = cfg.generate(seed)?;
+            write(&out, &study.to_csv())?;
+            if !quiet {
+                println!(
+                    "wrote {} ({} surveys)",
+                    out.display(),
+                    study.records().len()
+                );
+                print!("{}", StudySummary::of(&study)?.to_text());
+                println!("{SYNTHETIC}");
+            }
+            Ok(())
+        }
+        WorkloadCommand::Summary { data } => {
+            let study = Study::load(&data)?;
+            println!("{}: {} surveys", data.display(), study.records().len());
+            print!("{}", StudySummary::of(&study)?.to_text());
+            Ok(())
+        }
+        WorkloadCommand::Select {
+            data,
+            out,
+            cv,
+            quiet,
+        } => {
+            let study = Study::load(&data)?;
+            let t0 = Instant::now();
+            let sets: Vec<Dataset> = DatasetId::ALL
+                .iter()
+                .map(|&id| Dataset::build(&study, id))
+                .collect::<Result<_>>()?;
+            let refs: Vec<&Dataset> = sets.iter().collect();
+            let opts = cv.options();
+            let table = cross_validate(&refs, &Candidate::table(&opts.histories), &opts)?;
+            let elapsed = t0.elapsed();
+            write(&out.join("selection.md"), &table.to_markdown())?;
+            write(&out.join("selection.csv"), &table.to_csv())?;
+            write(&out.join("selection.json"), &table.to_json())?;
+            if !quiet {
+                print!("{}", table.to_markdown());
+                for id in DatasetId::ALL {
+                    if let Some(b) = table.best(id) {
+                        println!(
+                            "selected on {}: {}{} (median test MSE {:.4})",
+                            id.as_str().to_uppercase(),
+                            b.candidate.label(),
+                            b.candidate
+                                .history()
+                                .map_or(String::new(), |h| format!(" H = {h}")),
+                            b.median
+                        );
+                    }
+                }
+                println!("wrote {}/selection.{{md,csv,json}}", out.display());
+            }
+            println!(
+                "selection table: {} rows in {:.3} s (datasets + nested CV, {} threads requested)",
+                table.rows.len(),
+                elapsed.as_secs_f64(),
+                opts.threads
+            );
+            Ok(())
+        }
+        WorkloadCommand::Fit {
+            data,
+            population,
+            model,
+            history,
+            out,
+            name,
+            cv,
+        } => {
+            let study = Study::load(&data)?;
+            let id = DatasetId::parse(&population)?;
+            let cand = Candidate::parse(&model, history)?;
+            let d = Dataset::build(&study, id)?;
+            let (spec, lambda) = fit_on_all(&d, cand, &cv.options())?;
+            let name = name.unwrap_or_else(|| {
+                format!(
+                    "{}_{}{}",
+                    model,
+                    id.as_str(),
+                    cand.history().map_or(String::new(), |h| format!("_h{h}"))
+                )
+            });
+            let m = FittedModel::new(
+                name,
+                spec,
+                Provenance {
+                    dataset: Some(id.as_str().into()),
+                    data: Some(data.display().to_string()),
+                    n_pairs: Some(d.pairs.len()),
+                    cv_test_mse: None,
+                    note: lambda.map(|l| format!("ridge λ = {l} chosen by 5-fold CV")),
+                },
+            );
+            m.save(&out)?;
+            println!(
+                "wrote {} ({} on {}, {} pairs)",
+                out.display(),
+                cand.label(),
+                id.as_str().to_uppercase(),
+                d.pairs.len()
+            );
+            Ok(())
+        }
+        WorkloadCommand::Rollout {
+            model,
+            schedule,
+            wl0,
+            steps,
+            svg,
+        } => {
+            let m: FittedModel = match model.strip_prefix("bundled:") {
+                Some(name) => hil_workload::bundled::load_fitted(name)?,
+                None => FittedModel::load(&model)?,
+            };
+            hil_core::workload::check_wl0(wl0)?;
+            let queries = parse_schedule(&schedule)?;
+            let last = queries.last().map_or(0, |q| q.0);
+            let end = steps.unwrap_or(last + 10);
+            let mut history = QueryHistory::new();
+            let mut points = Vec::new();
+            let mut qi = 0;
+            println!("t,seconds,wl,query");
+            for t in 0..=end {
+                let mut asked = Vec::new();
+                while qi < queries.len() && queries[qi].0 == t {
+                    history.push(t, queries[qi].1)?;
+                    asked.push(format_kind(&queries[qi].1));
+                    qi += 1;
+                }
+                let wl = m.predict(wl0, &history, t)?;
+                println!("{t},{},{wl:.4},{}", t * 10, asked.join(" "));
+                points.push((t, wl, !asked.is_empty()));
+            }
+            if let Some(path) = svg {
+                write(&path, &svg_plot(&m.name, wl0, &points))?;
+                eprintln!("wrote {}", path.display());
+            }
+            Ok(())
+        }
+        WorkloadCommand::Bundle { dir, cv } => {
+            let t0 = Instant::now();
+            let study = bundled_study()?;
+            let csv = dir.join("data/synthetic_study.csv");
+            write(&csv, &study.to_csv())?;
+            let summary = StudySummary::of(&study)?;
+            let (table, models) = build_bundle(
+                &study,
+                "hil-workload/data/synthetic_study.csv",
+                &cv.options(),
+            )?;
+            write(
+                &dir.join("data/selection.md"),
+                &format!("{}\n{SYNTHETIC}\n", table.to_markdown()),
+            )?;
+            write(&dir.join("data/selection.csv"), &table.to_csv())?;
+            write(&dir.join("data/summary.txt"), &summary.to_text())?;
+            for m in &models {
+                m.save(dir.join(format!("models/{}.json", m.name)))?;
+                println!(
+                    "wrote models/{}.json: {}",
+                    m.name,
+                    m.provenance.note.as_deref().unwrap_or("")
+                );
+            }
+            print!("{}", summary.to_text());
+            println!(
+                "bundle regenerated in {:.2} s. {SYNTHETIC}",
+                t0.elapsed().as_secs_f64()
+            );
+            Ok(())
+        }
+    }
+}
+
+fn format_kind(k: &QueryKind) -> String {
+    format!(
+        "{}/{}/{}",
+        ["mcq", "bounding_box", "open_ended"][k.response as usize],
+        ["easy", "hard"][k.difficulty as usize],
+        ["none", "easy", "hard"][k.distraction as usize]
+    )
+}
+
+/// Parses `t:response/difficulty/distraction,...`.
+fn parse_schedule(s: &str) -> Result<Vec<(Timestep, QueryKind)>> {
+    let mut out: Vec<(Timestep, QueryKind)> = Vec::new();
+    for (i, item) in s
+        .split(',')
+        .map(str::trim)
+        .filter(|x| !x.is_empty())
+        .enumerate()
+    {
+        let bad = |why: String| HilError::invalid_parameter(format!("schedule[{i}]"), item, why);
+        let (t, kind) = item.split_once(':').unwrap_or((item, ""));
+        let t: Timestep = t
+            .trim()
+            .parse()
+            .map_err(|_| bad(format!("`{t}` is not a timestep (non-negative integer)")))?;
+        let mut k = QueryKind::default();
+        for (j, part) in kind
+            .split('/')
+            .map(str::trim)
+            .enumerate()
+            .filter(|(_, p)| !p.is_empty())
+        {
+            match j {
+                0 => {
+                    k.response = match part {
+                        "mcq" => ResponseType::Mcq,
+                        "bounding_box" | "bb" => ResponseType::BoundingBox,
+                        "open_ended" | "oe" => ResponseType::OpenEnded,
+                        _ => {
+                            return Err(bad(format!(
+                                "unknown response type `{part}` (mcq, bounding_box, open_ended)"
+                            )));
+                        }
+                    }
+                }
+                1 => {
+                    k.difficulty = match part {
+                        "easy" => Difficulty::Easy,
+                        "hard" => Difficulty::Hard,
+                        _ => return Err(bad(format!("unknown difficulty `{part}` (easy, hard)"))),
+                    }
+                }
+                2 => {
+                    k.distraction = match part {
+                        "none" => Distraction::None,
+                        "easy" => Distraction::Easy,
+                        "hard" => Distraction::Hard,
+                        _ => {
+                            return Err(bad(format!(
+                                "unknown distraction `{part}` (none, easy, hard)"
+                            )));
+                        }
+                    }
+                }
+                _ => {
+                    return Err(bad(
+                        "expected at most response/difficulty/distraction".into()
+                    ));
+                }
+            }
+        }
+        if let Some(prev) = out.last()
+            && t < prev.0
+        {
+            return Err(bad(format!(
+                "times must not decrease (previous query at {})",
+                prev.0
+            )));
+        }
+        out.push((t, k));
+    }
+    Ok(out)
+}
+
+/// A small line plot of WL_t with query markers.
+fn svg_plot(name: &str, wl0: f64, points: &[(Timestep, f64, bool)]) -> String {
+    let (w, h, m) = (640.0, 320.0, 40.0);
+    let tmax = points.last().map_or(1, |p| p.0.max(1)) as f64;
+    let x = |t: Timestep| m + (w - 2.0 * m) * t as f64 / tmax;
+    let y = |v: f64| h - m - (h - 2.0 * m) * v;
+    let path: Vec<String> = points
+        .iter()
+        .map(|&(t, v, _)| format!("{:.1},{:.1}", x(t), y(v)))
+        .collect();
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n\
+         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
+         <line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/>\n\
+         <line x1=\"{m}\" y1=\"{m}\" x2=\"{m}\" y2=\"{}\" stroke=\"black\"/>\n\
+         <text x=\"{m}\" y=\"20\">WL_t of {name} (WL_0 = {wl0}); Δt = 10 s; synthetic-data model</text>\n\
+         <text x=\"5\" y=\"{:.1}\">1</text><text x=\"5\" y=\"{:.1}\">0</text>\n\
+         <text x=\"{:.1}\" y=\"{}\">t = {tmax}</text>\n",
+        h - m,
+        w - m,
+        h - m,
+        h - m,
+        y(1.0) + 4.0,
+        y(0.0) + 4.0,
+        w - m - 30.0,
+        h - m + 16.0,
+    );
+    for &(t, _, q) in points.iter().filter(|p| p.2) {
+        let _ = q;
+        s.push_str(&format!("<line x1=\"{0:.1}\" y1=\"{m}\" x2=\"{0:.1}\" y2=\"{1}\" stroke=\"#c33\" stroke-dasharray=\"3,3\"/>\n", x(t), h - m));
+    }
+    s.push_str(&format!(
+        "<polyline fill=\"none\" stroke=\"#236\" stroke-width=\"2\" points=\"{}\"/>\n</svg>\n",
+        path.join(" ")
+    ));
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn schedule_parsing() {
+        let q = parse_schedule("3:mcq/easy/none, 9:oe/hard/easy,9").unwrap();
+        assert_eq!(q.len(), 3);
+        assert_eq!(q[1].1.response, ResponseType::OpenEnded);
+        assert_eq!(q[2].1, QueryKind::default());
+        assert!(
+            parse_schedule("3:telepathy")
+                .unwrap_err()
+                .to_string()
+                .contains("telepathy")
+        );
+        assert!(parse_schedule("5,3").is_err());
+    }
+}

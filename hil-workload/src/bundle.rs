@@ -1,0 +1,141 @@
+//! Regenerating the bundled study and models, and summarising a study.
+//!
+//! `hil workload bundle` runs [`build_bundle`] on [`bundled_study`] and
+//! writes `data/synthetic_study.csv` and `models/*.json`.
+
+use hil_core::Result;
+use serde::{Deserialize, Serialize};
+
+use crate::datasets::{Dataset, DatasetId, mean_std};
+use crate::models::{FittedModel, GrangerVariant, Provenance};
+use crate::select::{Candidate, SelectOptions, SelectionTable, cross_validate, fit_on_all};
+use crate::stats::{Alternative, TestResult, mann_whitney_u};
+use crate::study::Study;
+use crate::synth::SynthConfig;
+
+/// Seed of the bundled synthetic study.
+pub const STUDY_SEED: u64 = 20_240_601;
+
+/// The bundled synthetic study (regenerated deterministically).
+pub fn bundled_study() -> Result<Study> {
+    SynthConfig::default().generate(STUDY_SEED)
+}
+
+/// Headline figures of a study (compare with the paper's).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StudySummary {
+    /// (dataset, pairs, mean WL, sd WL, mean WL_0).
+    pub datasets: Vec<(DatasetId, usize, f64, f64, f64)>,
+    /// One-sided Mann-Whitney U, D1 < D2, on the workload scores.
+    pub d1_less_than_d2: Option<TestResult>,
+}
+
+impl StudySummary {
+    /// Summarises `study` (datasets without pairs are skipped).
+    pub fn of(study: &Study) -> Result<Self> {
+        let mut datasets = Vec::new();
+        let mut targets = Vec::new();
+        for id in DatasetId::ALL {
+            if let Ok(d) = Dataset::build(study, id) {
+                let t = d.targets();
+                let (m, s) = mean_std(&t);
+                let wl0 = d.pairs.iter().map(|p| p.wl0).sum::<f64>() / d.pairs.len() as f64;
+                datasets.push((id, t.len(), m, s, wl0));
+                targets.push((id, t));
+            }
+        }
+        let get = |id| targets.iter().find(|(d, _)| *d == id).map(|(_, t)| t);
+        let d1_less_than_d2 = match (get(DatasetId::D1), get(DatasetId::D2)) {
+            (Some(a), Some(b)) => Some(mann_whitney_u(a, b, Alternative::Less)?),
+            _ => None,
+        };
+        Ok(Self {
+            datasets,
+            d1_less_than_d2,
+        })
+    }
+
+    /// A human-readable summary.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        for (id, n, m, sd, wl0) in &self.datasets {
+            s.push_str(&format!(
+                "{}: {n} pairs, WL {m:.3} ± {sd:.3}, mean WL_0 {wl0:.3}\n",
+                id.as_str().to_uppercase()
+            ));
+        }
+        if let Some(t) = &self.d1_less_than_d2 {
+            s.push_str(&format!(
+                "Mann-Whitney U (D1 < D2): U = {}, p = {:.3e}\n",
+                t.statistic, t.p_value
+            ));
+        }
+        s
+    }
+}
+
+/// Fits the five bundled models from `study` and returns them with the
+/// selection table on all three datasets.
+pub fn build_bundle(
+    study: &Study,
+    data_label: &str,
+    opts: &SelectOptions,
+) -> Result<(SelectionTable, Vec<FittedModel>)> {
+    let sets: Vec<Dataset> = DatasetId::ALL
+        .iter()
+        .map(|&id| Dataset::build(study, id))
+        .collect::<Result<_>>()?;
+    let refs: Vec<&Dataset> = sets.iter().collect();
+    let table = cross_validate(&refs, &Candidate::table(&opts.histories), opts)?;
+    let sim = Candidate::Granger {
+        variant: GrangerVariant::Simulation,
+        h: 10,
+    };
+    let sim_table = cross_validate(&refs, &[sim], opts)?;
+    let note = "fitted on synthetic study data calibrated to the paper's published figures; not real participant data";
+    let mut models = Vec::new();
+    for (d, name) in [
+        (&sets[0], "f1_sim"),
+        (&sets[1], "f2_sim"),
+        (&sets[2], "f12_sim"),
+    ] {
+        let (spec, _) = fit_on_all(d, sim, opts)?;
+        let row = sim_table.row(d.id, sim).expect("scored above");
+        models.push(FittedModel::new(
+            name,
+            spec,
+            Provenance {
+                dataset: Some(d.id.as_str().into()),
+                data: Some(data_label.into()),
+                n_pairs: Some(d.pairs.len()),
+                cv_test_mse: Some([row.mean, row.std, row.median]),
+                note: Some(format!(
+                    "simulation variant (Granger H = 10, bounds [0.05, 1], w_0 ≤ 1); {note}"
+                )),
+            },
+        ));
+    }
+    for (d, name) in [(&sets[0], "f1_real"), (&sets[2], "f12_real")] {
+        let best = table.best(d.id).expect("table has rows");
+        let (spec, lambda) = fit_on_all(d, best.candidate, opts)?;
+        models.push(FittedModel::new(
+            name,
+            spec,
+            Provenance {
+                dataset: Some(d.id.as_str().into()),
+                data: Some(data_label.into()),
+                n_pairs: Some(d.pairs.len()),
+                cv_test_mse: Some([best.mean, best.std, best.median]),
+                note: Some(format!(
+                    "lowest median CV test MSE: {}{}{}; {note}",
+                    best.candidate.label(),
+                    best.candidate
+                        .history()
+                        .map_or(String::new(), |h| format!(" H = {h}")),
+                    lambda.map_or(String::new(), |l| format!(", λ = {l}")),
+                )),
+            },
+        ));
+    }
+    Ok((table, models))
+}

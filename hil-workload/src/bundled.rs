@@ -1,0 +1,60 @@
+//! Models shipped with the crate, fitted from the bundled synthetic study
+//! (`data/synthetic_study.csv`, calibrated to the paper's published figures;
+//! not real participant data).
+//!
+//! - `f1_sim`, `f2_sim`, `f12_sim`: the simulation variant (Granger H = 10,
+//!   γ and every w_i in [0.05, 1], w_0 ≤ 1) on D1, D2, D12;
+//! - `f1_real`, `f12_real`: the cross-validation winners on D1 and D12.
+//!
+//! Regenerate with `hil workload bundle` (see the crate README).
+
+use std::sync::Arc;
+
+use hil_core::{HilError, Result, WorkloadModel};
+
+use crate::models::FittedModel;
+
+/// Names of the bundled models.
+pub const NAMES: [&str; 5] = ["f1_sim", "f2_sim", "f12_sim", "f1_real", "f12_real"];
+
+/// The JSON text of a bundled model.
+pub fn json(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "f1_sim" => include_str!("../models/f1_sim.json"),
+        "f2_sim" => include_str!("../models/f2_sim.json"),
+        "f12_sim" => include_str!("../models/f12_sim.json"),
+        "f1_real" => include_str!("../models/f1_real.json"),
+        "f12_real" => include_str!("../models/f12_real.json"),
+        _ => return None,
+    })
+}
+
+/// Loads a bundled model with its metadata.
+pub fn load_fitted(name: &str) -> Result<FittedModel> {
+    let text = json(name).ok_or_else(|| {
+        HilError::invalid_parameter(
+            "name",
+            name,
+            format!(
+                "no bundled workload model by that name; available: {}",
+                NAMES.join(", ")
+            ),
+        )
+    })?;
+    FittedModel::from_json(text, format!("<bundled {name}.json>").as_ref())
+}
+
+/// Loads a bundled model.
+///
+/// ```
+/// use hil_core::{QueryHistory, QueryKind, WorkloadModel};
+/// let m = hil_workload::bundled::load("f1_sim").unwrap();
+/// let mut h = QueryHistory::new();
+/// let before = m.predict(0.5, &h, 3).unwrap();
+/// h.push(3, QueryKind::default()).unwrap();
+/// assert!(m.predict(0.5, &h, 3).unwrap() >= before);
+/// assert!(hil_workload::bundled::load("nope").is_err());
+/// ```
+pub fn load(name: &str) -> Result<Arc<dyn WorkloadModel>> {
+    Ok(Arc::new(load_fitted(name)?))
+}

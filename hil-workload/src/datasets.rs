@@ -1,0 +1,223 @@
+//! Training datasets D1, D2 and D12 built from a [`Study`].
+//!
+//! One training pair per query row: the target is that survey's workload
+//! score; the history holds the queries of the same condition up to and
+//! including it, on the Δt = 10 s grid.
+//!
+//! **Time.** `query_time_s` runs on the task clock (survey time excluded).
+//! Survey time is added back: the effective time of a query is its task time
+//! plus the survey durations of the earlier surveys in that condition, with
+//! the paper's assumption per dataset:
+//! - D1: every survey takes 0 s;
+//! - D2 and D12: people without limitations take 5 s, as does anyone whose
+//!   time was not logged; the logged time otherwise.
+//!
+//! The timestep of a query is `floor(effective_time / 10 s)`.
+//!
+//! **WL_0 (a documented choice; the paper does not say).** The initial
+//! workload of every pair is the participant's mean workload over their
+//! surveys without a query (the baseline conditions: distraction only). It
+//! measures the person's resting workload before any robot query. A
+//! participant with query rows but no baseline survey is an error.
+
+use std::collections::BTreeMap;
+
+use hil_core::{HilError, QueryHistory, Result, TimeGrid, Timestep};
+use serde::{Deserialize, Serialize};
+
+use crate::study::{Population, Study, StudyRecord};
+
+/// Which participants a dataset holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DatasetId {
+    /// Participants without mobility limitations.
+    D1,
+    /// Participants with mobility limitations and occupational therapists.
+    D2,
+    /// Both.
+    D12,
+}
+
+impl DatasetId {
+    /// All three, in table order.
+    pub const ALL: [Self; 3] = [Self::D1, Self::D2, Self::D12];
+
+    /// Lower-case name (`d1`, `d2`, `d12`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::D1 => "d1",
+            Self::D2 => "d2",
+            Self::D12 => "d12",
+        }
+    }
+
+    /// Parses `d1`, `d2` or `d12` (case-insensitive).
+    pub fn parse(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "d1" => Ok(Self::D1),
+            "d2" => Ok(Self::D2),
+            "d12" | "d1,2" | "d1_2" => Ok(Self::D12),
+            _ => Err(HilError::invalid_parameter(
+                "population",
+                s,
+                "expected d1, d2 or d12",
+            )),
+        }
+    }
+
+    /// Whether a participant of `pop` belongs to this dataset.
+    pub fn includes(self, pop: Population) -> bool {
+        match self {
+            Self::D1 => !pop.is_limited(),
+            Self::D2 => pop.is_limited(),
+            Self::D12 => true,
+        }
+    }
+
+    /// The survey duration assumed for `r` under this dataset's rule.
+    pub fn survey_seconds(self, r: &StudyRecord) -> f64 {
+        match self {
+            Self::D1 => 0.0,
+            Self::D2 | Self::D12 => {
+                if r.population.is_limited() {
+                    r.survey_time_s.unwrap_or(5.0)
+                } else {
+                    5.0
+                }
+            }
+        }
+    }
+}
+
+/// One (query history, workload) training pair.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrainingPair {
+    /// Index into [`Dataset::participants`].
+    pub participant: usize,
+    /// Initial workload (participant baseline).
+    pub wl0: f64,
+    /// Timestep of the query (where the workload was measured).
+    pub t: Timestep,
+    /// The condition's queries up to and including this one.
+    pub history: QueryHistory,
+    /// Measured workload after the query.
+    pub target: f64,
+}
+
+/// A dataset of training pairs.
+#[derive(Clone, Debug)]
+pub struct Dataset {
+    /// Which dataset this is.
+    pub id: DatasetId,
+    /// Participant ids (pairs refer to them by index).
+    pub participants: Vec<String>,
+    /// The pairs, in study order.
+    pub pairs: Vec<TrainingPair>,
+}
+
+impl Dataset {
+    /// Builds dataset `id` from `study` with the default Δt = 10 s.
+    ///
+    /// ```
+    /// use hil_workload::{datasets::{Dataset, DatasetId}, synth::SynthConfig};
+    /// let study = SynthConfig::small(3, 1).generate(7).unwrap();
+    /// let d1 = Dataset::build(&study, DatasetId::D1).unwrap();
+    /// assert_eq!(d1.pairs.len(), 3 * 48);
+    /// ```
+    pub fn build(study: &Study, id: DatasetId) -> Result<Self> {
+        Self::build_with_grid(study, id, TimeGrid::default())
+    }
+
+    /// Builds dataset `id` on a custom time grid.
+    pub fn build_with_grid(study: &Study, id: DatasetId, grid: TimeGrid) -> Result<Self> {
+        let mut participants: Vec<String> = Vec::new();
+        let mut p_index: BTreeMap<&str, usize> = BTreeMap::new();
+        // participant -> (sum, count) of baseline workloads
+        let mut baseline: BTreeMap<usize, (f64, usize)> = BTreeMap::new();
+        // (participant, condition) -> query rows, in file order
+        let mut conditions: BTreeMap<(usize, &str), Vec<&StudyRecord>> = BTreeMap::new();
+        let mut order: Vec<(usize, &str)> = Vec::new();
+        for r in study.records().iter().filter(|r| id.includes(r.population)) {
+            let p = *p_index.entry(&r.participant).or_insert_with(|| {
+                participants.push(r.participant.clone());
+                participants.len() - 1
+            });
+            match r.query {
+                None => {
+                    let e = baseline.entry(p).or_insert((0.0, 0));
+                    e.0 += r.tlx.workload();
+                    e.1 += 1;
+                }
+                Some(_) => {
+                    let key = (p, r.condition.as_str());
+                    let v = conditions.entry(key).or_default();
+                    if v.is_empty() {
+                        order.push(key);
+                    }
+                    v.push(r);
+                }
+            }
+        }
+        let mut pairs = Vec::new();
+        for key in order {
+            let rows = &conditions[&key];
+            let p = key.0;
+            let Some(&(sum, n)) = baseline.get(&p) else {
+                return Err(HilError::Data {
+                    path: study.source().to_path_buf(),
+                    record: rows[0].line,
+                    field: "participant".into(),
+                    why: format!(
+                        "participant `{}` has query rows but no survey without a query, so WL_0 (their baseline workload) is unknown",
+                        participants[p]
+                    ),
+                });
+            };
+            let wl0 = sum / n as f64;
+            let mut sorted: Vec<&StudyRecord> = rows.clone();
+            sorted.sort_by(|a, b| a.query_time_s.total_cmp(&b.query_time_s));
+            let mut history = QueryHistory::new();
+            let mut survey_offset = 0.0;
+            for r in sorted {
+                let t = grid.step_of(r.query_time_s + survey_offset);
+                let kind = r.kind().expect("query rows only");
+                history.push(t, kind)?;
+                pairs.push(TrainingPair {
+                    participant: p,
+                    wl0,
+                    t,
+                    history: history.clone(),
+                    target: r.tlx.workload(),
+                });
+                survey_offset += id.survey_seconds(r);
+            }
+        }
+        if pairs.is_empty() {
+            return Err(HilError::Data {
+                path: study.source().to_path_buf(),
+                record: 1,
+                field: "population".into(),
+                why: format!("dataset {} has no query rows", id.as_str().to_uppercase()),
+            });
+        }
+        Ok(Self {
+            id,
+            participants,
+            pairs,
+        })
+    }
+
+    /// Workload scores of all surveys with a query (the targets).
+    pub fn targets(&self) -> Vec<f64> {
+        self.pairs.iter().map(|p| p.target).collect()
+    }
+}
+
+/// Mean and population standard deviation.
+pub fn mean_std(xs: &[f64]) -> (f64, f64) {
+    let n = xs.len().max(1) as f64;
+    let m = xs.iter().sum::<f64>() / n;
+    let v = xs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / n;
+    (m, v.sqrt())
+}

@@ -1,0 +1,599 @@
+//! The study-data format: one CSV row per TLX survey, with a validating
+//! loader whose errors name the file, line and column.
+//!
+//! Columns (a header row names them; any order; every column required, no
+//! extras, no duplicates):
+//!
+//! | column | values |
+//! |---|---|
+//! | `participant` | participant id (non-empty text) |
+//! | `population` | `no_limitation`, `mobility_limitation`, `occupational_therapist` |
+//! | `condition` | condition id (non-empty text), unique per participant |
+//! | `query_time_s` | seconds from the condition start (≥ 0) when the query was posed (or, for a survey without a query, when the survey was taken), on the task clock that excludes survey time |
+//! | `difficulty` | `easy`, `hard`, or empty for a survey without a query |
+//! | `response_type` | `mcq`, `bounding_box`, `open_ended`, or empty without a query |
+//! | `distraction` | `none`, `easy`, `hard` |
+//! | `interval_min` | `1` or `2`, or empty without a query |
+//! | `mental`, `temporal`, `performance`, `effort`, `frustration` | TLX answers, integers 1..=5 |
+//! | `survey_time_s` | seconds the survey took (≥ 0), or empty if not logged |
+//!
+//! A row with a query has `difficulty`, `response_type` and `interval_min`
+//! all set; a row without (a baseline condition: distraction only) has all
+//! three empty. Baseline surveys give each participant's initial workload
+//! WL_0 (see [`crate::datasets`]).
+//!
+//! ```
+//! use hil_workload::study::Study;
+//! let csv = "participant,population,condition,query_time_s,difficulty,response_type,distraction,interval_min,mental,temporal,performance,effort,frustration,survey_time_s\n\
+//!            p1,no_limitation,base,330,,,easy,,2,1,4,2,1,\n\
+//!            p1,no_limitation,c1,60,easy,mcq,none,1,3,2,4,3,1,12.5\n";
+//! let study = Study::parse(csv, "inline.csv".as_ref()).unwrap();
+//! assert_eq!(study.records().len(), 2);
+//! let bad = csv.replace("3,2,4,3,1,12.5", "3,2,4,7,1,12.5");
+//! let err = Study::parse(&bad, "inline.csv".as_ref()).unwrap_err().to_string();
+//! assert!(err.contains("inline.csv:3") && err.contains("effort"));
+//! ```
+
+use std::collections::{HashMap, HashSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use hil_core::{Difficulty, Distraction, HilError, QueryKind, ResponseType, Result};
+use serde::{Deserialize, Serialize};
+
+use crate::tlx::TlxAnswers;
+
+/// The columns of the study CSV, in the order the writer uses.
+pub const COLUMNS: [&str; 14] = [
+    "participant",
+    "population",
+    "condition",
+    "query_time_s",
+    "difficulty",
+    "response_type",
+    "distraction",
+    "interval_min",
+    "mental",
+    "temporal",
+    "performance",
+    "effort",
+    "frustration",
+    "survey_time_s",
+];
+
+/// Which population a participant belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Population {
+    /// Participants without mobility limitations (dataset D1).
+    NoLimitation,
+    /// Participants with mobility limitations (D2).
+    MobilityLimitation,
+    /// Occupational therapists simulating limitations (D2).
+    OccupationalTherapist,
+}
+
+impl Population {
+    /// The CSV spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::NoLimitation => "no_limitation",
+            Self::MobilityLimitation => "mobility_limitation",
+            Self::OccupationalTherapist => "occupational_therapist",
+        }
+    }
+
+    /// True for the populations of dataset D2.
+    pub fn is_limited(self) -> bool {
+        !matches!(self, Self::NoLimitation)
+    }
+}
+
+/// The query posed before a survey.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PosedQuery {
+    /// Query difficulty.
+    pub difficulty: Difficulty,
+    /// How the participant answered.
+    pub response: ResponseType,
+    /// Minutes between queries in this condition (1 or 2).
+    pub interval_min: u8,
+}
+
+/// One survey row.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StudyRecord {
+    /// Participant id.
+    pub participant: String,
+    /// The participant's population.
+    pub population: Population,
+    /// Condition id.
+    pub condition: String,
+    /// Seconds from the condition start (task clock, survey time excluded).
+    pub query_time_s: f64,
+    /// The query, or `None` for a survey without one (baseline condition).
+    pub query: Option<PosedQuery>,
+    /// The concurrent distraction task.
+    pub distraction: Distraction,
+    /// The TLX answers.
+    pub tlx: TlxAnswers,
+    /// Logged survey duration in seconds, if any.
+    pub survey_time_s: Option<f64>,
+    /// 1-based line in the source file (0 for generated records).
+    #[serde(skip)]
+    pub line: usize,
+}
+
+impl StudyRecord {
+    /// The hil-core query kind, if this row has a query.
+    pub fn kind(&self) -> Option<QueryKind> {
+        self.query.map(|q| QueryKind {
+            response: q.response,
+            difficulty: q.difficulty,
+            distraction: self.distraction,
+        })
+    }
+}
+
+/// A validated study: every record well-formed, at least one record.
+#[derive(Clone, Debug)]
+pub struct Study {
+    source: PathBuf,
+    records: Vec<StudyRecord>,
+}
+
+fn data_err(
+    path: &Path,
+    line: usize,
+    field: impl Into<String>,
+    why: impl Into<String>,
+) -> HilError {
+    HilError::Data {
+        path: path.to_path_buf(),
+        record: line,
+        field: field.into(),
+        why: why.into(),
+    }
+}
+
+impl Study {
+    /// Builds a study from records (e.g. generated ones), validating them.
+    pub fn from_records(source: impl Into<PathBuf>, records: Vec<StudyRecord>) -> Result<Self> {
+        let s = Self {
+            source: source.into(),
+            records,
+        };
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Reads and validates a study CSV.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses and validates study CSV text; `path` names it in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self> {
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
+        let Some((header_idx, header)) = lines.next() else {
+            return Err(data_err(
+                path,
+                1,
+                "header",
+                "the file is empty: expected a header row",
+            ));
+        };
+        let header_line = header_idx + 1;
+        let mut index: HashMap<&str, usize> = HashMap::new();
+        let names: Vec<&str> = header
+            .split(',')
+            .map(|c| c.trim().trim_start_matches('\u{feff}'))
+            .collect();
+        for (i, name) in names.iter().enumerate() {
+            if !COLUMNS.contains(name) {
+                return Err(data_err(
+                    path,
+                    header_line,
+                    format!("column {} (`{name}`)", i + 1),
+                    format!(
+                        "unknown column; expected the columns {}",
+                        COLUMNS.join(", ")
+                    ),
+                ));
+            }
+            if index.insert(name, i).is_some() {
+                return Err(data_err(
+                    path,
+                    header_line,
+                    format!("column {} (`{name}`)", i + 1),
+                    "duplicated column",
+                ));
+            }
+        }
+        if let Some(missing) = COLUMNS.iter().find(|c| !index.contains_key(*c)) {
+            return Err(data_err(path, header_line, *missing, "missing column"));
+        }
+        let col = |name: &str| index[name];
+        let mut records = Vec::new();
+        for (idx, raw) in lines {
+            let line = idx + 1;
+            let cells: Vec<&str> = raw.split(',').map(str::trim).collect();
+            if cells.len() != names.len() {
+                return Err(data_err(
+                    path,
+                    line,
+                    "row",
+                    format!(
+                        "{} cells, but the header has {} columns",
+                        cells.len(),
+                        names.len()
+                    ),
+                ));
+            }
+            let cell = |name: &str| -> (&str, String) {
+                let i = col(name);
+                (cells[i], format!("column {} (`{name}`)", i + 1))
+            };
+            let req = |name: &str| -> Result<(&str, String)> {
+                let (v, f) = cell(name);
+                if v.is_empty() {
+                    Err(data_err(path, line, f, "empty, but a value is required"))
+                } else {
+                    Ok((v, f))
+                }
+            };
+            let enum_of = |name: &str, allowed: &[&str]| -> Result<Option<usize>> {
+                let (v, f) = cell(name);
+                if v.is_empty() {
+                    return Ok(None);
+                }
+                allowed
+                    .iter()
+                    .position(|a| *a == v)
+                    .map(Some)
+                    .ok_or_else(|| {
+                        data_err(
+                            path,
+                            line,
+                            f,
+                            format!(
+                                "unknown value `{v}`; expected one of {}",
+                                allowed.join(", ")
+                            ),
+                        )
+                    })
+            };
+            let seconds = |name: &str, v: &str, f: &str| -> Result<f64> {
+                let x: f64 = v
+                    .parse()
+                    .map_err(|_| data_err(path, line, f, format!("`{v}` is not a number")))?;
+                if !x.is_finite() || x < 0.0 {
+                    return Err(data_err(
+                        path,
+                        line,
+                        f,
+                        format!("{name} must be a finite number ≥ 0, got {v}"),
+                    ));
+                }
+                Ok(x)
+            };
+            let (participant, _) = req("participant")?;
+            let (condition, _) = req("condition")?;
+            let pops = [
+                "no_limitation",
+                "mobility_limitation",
+                "occupational_therapist",
+            ];
+            req("population")?;
+            let population = [
+                Population::NoLimitation,
+                Population::MobilityLimitation,
+                Population::OccupationalTherapist,
+            ][enum_of("population", &pops)?.unwrap_or(0)];
+            let (t, tf) = req("query_time_s")?;
+            let query_time_s = seconds("a time", t, &tf)?;
+            req("distraction")?;
+            let distraction =
+                Distraction::ALL[enum_of("distraction", &["none", "easy", "hard"])?.unwrap_or(0)];
+            let difficulty = enum_of("difficulty", &["easy", "hard"])?.map(|i| Difficulty::ALL[i]);
+            let response = enum_of("response_type", &["mcq", "bounding_box", "open_ended"])?
+                .map(|i| ResponseType::ALL[i]);
+            let interval = enum_of("interval_min", &["1", "2"])?.map(|i| i as u8 + 1);
+            let query = match (difficulty, response, interval) {
+                (Some(difficulty), Some(response), Some(interval_min)) => Some(PosedQuery {
+                    difficulty,
+                    response,
+                    interval_min,
+                }),
+                (None, None, None) => None,
+                _ => {
+                    let missing = [
+                        ("difficulty", difficulty.is_none()),
+                        ("response_type", response.is_none()),
+                        ("interval_min", interval.is_none()),
+                    ]
+                    .into_iter()
+                    .find(|(_, m)| *m)
+                    .map(|(n, _)| n)
+                    .unwrap_or("difficulty");
+                    return Err(data_err(
+                        path,
+                        line,
+                        cell(missing).1,
+                        "a query row needs difficulty, response_type and interval_min all set (a survey without a query leaves all three empty)",
+                    ));
+                }
+            };
+            let mut likert = [0u8; 5];
+            for (k, name) in ["mental", "temporal", "performance", "effort", "frustration"]
+                .iter()
+                .enumerate()
+            {
+                let (v, f) = req(name)?;
+                likert[k] = v
+                    .parse::<u8>()
+                    .ok()
+                    .filter(|a| (1..=5).contains(a))
+                    .ok_or_else(|| {
+                        data_err(
+                            path,
+                            line,
+                            f,
+                            format!("`{v}` is not a Likert answer: expected an integer in 1..=5"),
+                        )
+                    })?;
+            }
+            let tlx = TlxAnswers::new(likert[0], likert[1], likert[2], likert[3], likert[4])?;
+            let (st, stf) = cell("survey_time_s");
+            let survey_time_s = if st.is_empty() {
+                None
+            } else {
+                Some(seconds("a survey time", st, &stf)?)
+            };
+            records.push(StudyRecord {
+                participant: participant.to_string(),
+                population,
+                condition: condition.to_string(),
+                query_time_s,
+                query,
+                distraction,
+                tlx,
+                survey_time_s,
+                line,
+            });
+        }
+        let s = Self {
+            source: path.to_path_buf(),
+            records,
+        };
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Cross-row checks: non-empty; one population per participant; one
+    /// distraction per condition; no two surveys at the same time.
+    fn validate(&self) -> Result<()> {
+        let path = &self.source;
+        if self.records.is_empty() {
+            return Err(data_err(path, 1, "(file)", "the dataset has no records"));
+        }
+        let mut pop: HashMap<&str, Population> = HashMap::new();
+        let mut dist: HashMap<(&str, &str), Distraction> = HashMap::new();
+        let mut seen: HashSet<(&str, &str, u64)> = HashSet::new();
+        for (i, r) in self.records.iter().enumerate() {
+            let line = if r.line > 0 { r.line } else { i + 2 };
+            if r.participant.is_empty() || r.participant.contains(',') {
+                return Err(data_err(
+                    path,
+                    line,
+                    "participant",
+                    "must be non-empty and contain no comma",
+                ));
+            }
+            if r.condition.is_empty() || r.condition.contains(',') {
+                return Err(data_err(
+                    path,
+                    line,
+                    "condition",
+                    "must be non-empty and contain no comma",
+                ));
+            }
+            if !(r.query_time_s.is_finite() && r.query_time_s >= 0.0) {
+                return Err(data_err(
+                    path,
+                    line,
+                    "query_time_s",
+                    format!("must be finite and ≥ 0, got {}", r.query_time_s),
+                ));
+            }
+            if let Some(s) = r.survey_time_s
+                && !(s.is_finite() && s >= 0.0)
+            {
+                return Err(data_err(
+                    path,
+                    line,
+                    "survey_time_s",
+                    format!("must be finite and ≥ 0, got {s}"),
+                ));
+            }
+            if let Some(q) = r.query
+                && !(1..=2).contains(&q.interval_min)
+            {
+                return Err(data_err(
+                    path,
+                    line,
+                    "interval_min",
+                    format!("must be 1 or 2, got {}", q.interval_min),
+                ));
+            }
+            TlxAnswers::new(
+                r.tlx.mental,
+                r.tlx.temporal,
+                r.tlx.performance,
+                r.tlx.effort,
+                r.tlx.frustration,
+            )
+            .map_err(|e| data_err(path, line, "tlx", e.to_string()))?;
+            if let Some(p) = pop.insert(&r.participant, r.population)
+                && p != r.population
+            {
+                return Err(data_err(
+                    path,
+                    line,
+                    "population",
+                    format!(
+                        "participant `{}` was `{}` on an earlier row, `{}` here",
+                        r.participant,
+                        p.as_str(),
+                        r.population.as_str()
+                    ),
+                ));
+            }
+            if let Some(d) = dist.insert((&r.participant, &r.condition), r.distraction)
+                && d != r.distraction
+            {
+                return Err(data_err(
+                    path,
+                    line,
+                    "distraction",
+                    format!(
+                        "condition `{}` of participant `{}` has two distraction settings",
+                        r.condition, r.participant
+                    ),
+                ));
+            }
+            if !seen.insert((&r.participant, &r.condition, r.query_time_s.to_bits())) {
+                return Err(data_err(
+                    path,
+                    line,
+                    "query_time_s",
+                    format!(
+                        "duplicate survey: participant `{}`, condition `{}` already has a row at {} s",
+                        r.participant, r.condition, r.query_time_s
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The records, in file order.
+    pub fn records(&self) -> &[StudyRecord] {
+        &self.records
+    }
+
+    /// Where the study came from (a file, or a label for generated data).
+    pub fn source(&self) -> &Path {
+        &self.source
+    }
+
+    /// Renders the study as CSV in the documented format.
+    pub fn to_csv(&self) -> String {
+        let mut out = COLUMNS.join(",");
+        out.push('\n');
+        for r in &self.records {
+            let (d, rt, iv) = match r.query {
+                Some(q) => (
+                    ["easy", "hard"][q.difficulty as usize],
+                    ["mcq", "bounding_box", "open_ended"][q.response as usize],
+                    q.interval_min.to_string(),
+                ),
+                None => ("", "", String::new()),
+            };
+            let _ = writeln!(
+                out,
+                "{},{},{},{},{d},{rt},{},{iv},{},{},{},{},{},{}",
+                r.participant,
+                r.population.as_str(),
+                r.condition,
+                r.query_time_s,
+                ["none", "easy", "hard"][r.distraction as usize],
+                r.tlx.mental,
+                r.tlx.temporal,
+                r.tlx.performance,
+                r.tlx.effort,
+                r.tlx.frustration,
+                r.survey_time_s.map(|s| s.to_string()).unwrap_or_default(),
+            );
+        }
+        out
+    }
+
+    /// Writes the study as CSV.
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        std::fs::write(path, self.to_csv()).map_err(|e| HilError::io("writing", path, e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEADER: &str = "participant,population,condition,query_time_s,difficulty,response_type,distraction,interval_min,mental,temporal,performance,effort,frustration,survey_time_s";
+
+    fn parse(body: &str) -> Result<Study> {
+        Study::parse(&format!("{HEADER}\n{body}"), Path::new("s.csv"))
+    }
+
+    fn err(body: &str) -> String {
+        parse(body).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn good_rows_round_trip() {
+        let s = parse("p1,mobility_limitation,c1,60,hard,open_ended,easy,2,1,2,3,4,5,30.5\np1,mobility_limitation,b,330,,,hard,,1,1,1,1,1,\n").unwrap();
+        assert_eq!(s.records().len(), 2);
+        let again = Study::parse(&s.to_csv(), Path::new("s.csv")).unwrap();
+        assert_eq!(again.records(), s.records());
+    }
+
+    #[test]
+    fn bad_inputs_name_file_line_and_column() {
+        let e = err("p1,no_limitation,c1,60,easy,mcq,none,1,1,2,3,4,6,\n");
+        assert!(
+            e.contains("s.csv:2") && e.contains("column 13 (`frustration`)"),
+            "{e}"
+        );
+        let e = err("p1,no_limitation,c1,60,medium,mcq,none,1,1,2,3,4,5,\n");
+        assert!(
+            e.contains("s.csv:2") && e.contains("`difficulty`") && e.contains("medium"),
+            "{e}"
+        );
+        let e = err("p1,no_limitation,c1,-3,easy,mcq,none,1,1,2,3,4,5,\n");
+        assert!(e.contains("query_time_s") && e.contains("≥ 0"), "{e}");
+        let e = err("p1,no_limitation,c1,3,easy,mcq,none,1,1,2,3,4,5,-1\n");
+        assert!(e.contains("survey_time_s"), "{e}");
+        let e = err("p1,no_limitation,c1,3,easy,,none,1,1,2,3,4,5,\n");
+        assert!(e.contains("response_type"), "{e}");
+        let e = err("p1,martian,c1,3,easy,mcq,none,1,1,2,3,4,5,\n");
+        assert!(e.contains("population") && e.contains("martian"), "{e}");
+        let e = err("");
+        assert!(e.contains("no records"), "{e}");
+        let e = Study::parse("participant,population\n", Path::new("s.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing column"), "{e}");
+        let dup = HEADER.replace("frustration", "mental");
+        let e = Study::parse(&format!("{dup}\n"), Path::new("s.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("duplicated column") && e.contains("column 13"),
+            "{e}"
+        );
+        let e = err(
+            "p1,no_limitation,c1,3,easy,mcq,none,1,1,2,3,4,5,\np1,no_limitation,c1,3,easy,mcq,none,1,1,2,3,4,5,\n",
+        );
+        assert!(e.contains("s.csv:3") && e.contains("duplicate"), "{e}");
+        let e = Study::parse("", Path::new("s.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("empty"), "{e}");
+    }
+}

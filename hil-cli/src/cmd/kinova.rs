@@ -12,10 +12,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use hil_core::config::{BuildContext, PolicyConfig, WorkloadModelConfig};
-use hil_core::{
-    Environment, HilError, Query, QueryChannel, Response, Result, Session, SessionSettings,
-};
+use hil_core::config::{BuildContext, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
+use hil_core::{Environment, HilError, Result, Session, SessionSettings};
 use hil_kinova_mujoco::calibrate::calibrate_foods;
 use hil_kinova_mujoco::food::FoodKind;
 use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
@@ -87,7 +85,8 @@ pub struct KinovaDemoArgs {
     #[arg(long)]
     pub render: Option<PathBuf>,
     /// TOML overriding the components: tables `linucb`, `always_query`,
-    /// `linucb_qg` (policy configs), `workload` and `environment`.
+    /// `linucb_qg` (policy configs), `workload`, `channel` and `environment`
+    /// (a `kinova_feeding` config without `type`).
     #[arg(long)]
     pub components: Option<PathBuf>,
     /// Print a JSON object instead of a table.
@@ -202,27 +201,6 @@ fn method_order(rep: usize) -> [usize; 3] {
     ORDERS[rep % 6]
 }
 
-/// The participant: answers a query with the action a caregiver who knows
-/// the food would name (the environment's best action).
-#[derive(Debug, Default)]
-struct Caregiver {
-    asked: usize,
-}
-
-impl QueryChannel for Caregiver {
-    fn name(&self) -> &str {
-        "caregiver"
-    }
-    fn ask(&mut self, query: &Query) -> Result<Response> {
-        self.asked += 1;
-        let arm = query.oracle_best.ok_or_else(|| HilError::Channel {
-            channel: "caregiver".into(),
-            why: "the environment names no best action".into(),
-        })?;
-        Ok(Response::action(arm))
-    }
-}
-
 #[derive(Debug, Serialize)]
 struct PlateResult {
     method: &'static str,
@@ -261,7 +239,7 @@ fn components(path: Option<&Path>) -> Result<toml::Table> {
         {
             return Err(HilError::invalid_input(
                 format!("{}: table `{key}`", path.display()),
-                "unknown; expected linucb, always_query, linucb_qg, workload or environment",
+                "unknown; expected linucb, always_query, linucb_qg, workload, channel or environment",
             ));
         }
     }
@@ -290,6 +268,19 @@ fn policy_config(table: &toml::Table, key: &str) -> Result<Box<dyn PolicyConfig>
             format!("{e} (is hil-policies built in, with a policy type named `{key}`?)"),
         )
     })
+}
+
+/// The participant answering queries: hil-channels' `simulated_expert`
+/// (a perfect expert by default) unless `[channel]` says otherwise.
+fn channel_config(table: &toml::Table) -> Result<Box<dyn QueryChannelConfig>> {
+    let value = table.get("channel").cloned().unwrap_or_else(|| {
+        let mut t = toml::Table::new();
+        t.insert("type".into(), toml::Value::String("simulated_expert".into()));
+        toml::Value::Table(t)
+    });
+    value
+        .try_into()
+        .map_err(|e: toml::de::Error| HilError::invalid_input("channel", e.to_string()))
 }
 
 fn workload_config(table: &toml::Table) -> Result<Box<dyn WorkloadModelConfig>> {
@@ -375,7 +366,7 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
                 eprintln!("repetition {} plate {}: {label}", rep + 1, position + 1);
             }
             let seed = hil_core::session::splitmix(args.seed, (rep * 3 + position) as u64);
-            let mut channel = Caregiver::default();
+            let mut channel = channel_config(&table)?.build(&ctx)?;
             recorder.set_prefix(format!("rep{}_{}", rep + 1, METHODS[m].1));
             let report = {
                 let mut render_env;
@@ -389,7 +380,7 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
                     settings: settings.clone(),
                     environment,
                     policy: policies[m].as_mut(),
-                    channel: &mut channel,
+                    channel: channel.as_mut(),
                     workload: Arc::clone(&workload),
                     forecast: None,
                 };

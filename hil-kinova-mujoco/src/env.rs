@@ -160,7 +160,10 @@ const PRETRAIN_STREAM: u64 = 0x7072_6574_7261_696e;
 
 /// Runs `cfg.pretraining_trials` attempts of every action on every distinct
 /// food of the plate and returns them as labelled observations.
-pub fn simulated_pretraining(cfg: &KinovaFeedingConfig, seed: u64) -> Result<Vec<LabelledObservation>> {
+pub fn simulated_pretraining(
+    cfg: &KinovaFeedingConfig,
+    seed: u64,
+) -> Result<Vec<LabelledObservation>> {
     let mut foods = cfg.foods()?;
     foods.sort();
     foods.dedup();
@@ -175,7 +178,10 @@ pub fn simulated_pretraining(cfg: &KinovaFeedingConfig, seed: u64) -> Result<Vec
         for arm in 0..ACTIONS.len() {
             for t in 0..cfg.pretraining_trials {
                 let stream = (food.index() * ACTIONS.len() + arm) * cfg.pretraining_trials + t;
-                env.reset(hil_core::session::splitmix(seed ^ PRETRAIN_STREAM, stream as u64))?;
+                env.reset(hil_core::session::splitmix(
+                    seed ^ PRETRAIN_STREAM,
+                    stream as u64,
+                ))?;
                 env.next_item()?;
                 let context = env.observe()?;
                 let reward = env.execute(ArmId(arm))?.reward();

@@ -261,7 +261,10 @@ fn default_policy(key: &str) -> toml::Value {
 }
 
 fn policy_config(table: &toml::Table, key: &str) -> Result<Box<dyn PolicyConfig>> {
-    let value = table.get(key).cloned().unwrap_or_else(|| default_policy(key));
+    let value = table
+        .get(key)
+        .cloned()
+        .unwrap_or_else(|| default_policy(key));
     value.try_into().map_err(|e: toml::de::Error| {
         HilError::invalid_input(
             format!("policy `{key}`"),
@@ -275,7 +278,10 @@ fn policy_config(table: &toml::Table, key: &str) -> Result<Box<dyn PolicyConfig>
 fn channel_config(table: &toml::Table) -> Result<Box<dyn QueryChannelConfig>> {
     let value = table.get("channel").cloned().unwrap_or_else(|| {
         let mut t = toml::Table::new();
-        t.insert("type".into(), toml::Value::String("simulated_expert".into()));
+        t.insert(
+            "type".into(),
+            toml::Value::String("simulated_expert".into()),
+        );
         toml::Value::Table(t)
     });
     value

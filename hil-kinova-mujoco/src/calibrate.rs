@@ -1,9 +1,14 @@
 //! Success rates per (food, action) over randomised trials, beside the
 //! published rates (Feng et al. 2019, setting `all`).
 //!
-//! ```no_run
-//! let report = hil_kinova_mujoco::calibrate(30, 1)?;
-//! println!("{}", serde_json::to_string_pretty(&report).unwrap());
+//! ```
+//! use hil_kinova_mujoco::calibrate::calibrate_foods;
+//! use hil_kinova_mujoco::FoodKind;
+//!
+//! // `calibrate(30, 1)` runs every food; one trial on carrot here.
+//! let report = calibrate_foods(&[FoodKind::Carrot], 1, 1, &mut |_, _| {})?;
+//! assert_eq!(report.rows.len(), 6);
+//! assert_eq!(report.rows[1].published, Some(0.53)); // VS90
 //! # Ok::<(), hil_core::HilError>(())
 //! ```
 

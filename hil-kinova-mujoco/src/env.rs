@@ -1,7 +1,7 @@
 //! [`KinovaFeedingEnv`]: the MuJoCo feeding simulation as a
 //! `hil_core::Environment`, and its config type `kinova_feeding`.
 //!
-//! ```no_run
+//! ```
 //! use hil_core::Environment;
 //! use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
 //!

@@ -22,16 +22,20 @@ struct Cli {
 enum Command {
     /// Run an experiment described by a TOML config.
     Run(cmd::run::RunArgs),
-    /// Generate or check food datasets.
-    Data(cmd::data::DataArgs),
     /// Rerun the paper's simulated experiments: results.json, tables.md, SVG figures.
     Reproduce(cmd::reproduce::ReproduceArgs),
+    /// Generate or check food datasets.
+    Data(cmd::data::DataArgs),
+    /// Demonstrations (`hil demo kinova`: the user study in MuJoCo).
+    Demo(cmd::kinova::DemoArgs),
+    /// The MuJoCo Kinova Gen3 feeding simulation (`hil kinova calibrate`).
+    Kinova(cmd::kinova::KinovaArgs),
+    /// Benchmark components (e.g. `hil bench policy --policy linucb_qg`).
+    Bench(cmd::bench::BenchArgs),
     /// Workload study data and models: generate, select, fit, rollout, bundle.
     Workload(cmd::workload::WorkloadArgs),
     /// Inspect plugin libraries and check their types for conformance.
     Plugins(cmd::plugins::PluginsArgs),
-    /// Benchmark components (e.g. `hil bench policy --policy linucb_qg`).
-    Bench(cmd::bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -45,11 +49,13 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
-        Command::Data(args) => cmd::data::run(args),
         Command::Reproduce(args) => cmd::reproduce::run(args),
+        Command::Data(args) => cmd::data::run(args),
+        Command::Demo(args) => cmd::kinova::demo(args),
+        Command::Kinova(args) => cmd::kinova::kinova(args),
+        Command::Bench(args) => cmd::bench::run(args),
         Command::Workload(args) => cmd::workload::run(args),
         Command::Plugins(args) => cmd::plugins::run(args),
-        Command::Bench(args) => cmd::bench::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

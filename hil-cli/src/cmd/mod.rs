@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod data;
+pub mod kinova;
 pub mod plugins;
 pub mod reproduce;
 pub mod run;

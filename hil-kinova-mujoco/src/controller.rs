@@ -1,0 +1,250 @@
+//! The six skewering actions and the arm's differential inverse kinematics.
+//!
+//! An action is a fork pitch β (handle relative to vertical, G21: VS 0, TV
+//! −0.5, TA +0.4 rad), a roll of the tine row relative to the food's
+//! perceived major axis (0 or 90°) and a force threshold (VS 25 N, TV 20 N,
+//! TA 10 N). The arm keeps the fork base pointing straight down, turned
+//! about the vertical so that the tine row makes the commanded roll with the
+//! major axis; the fork's pitch motor sets β and its roll motor holds γ = 0.
+//! The tines curve 0.26 rad towards the fork's +z, so VS tines lean 0.26 rad,
+//! TV tines −0.24 rad (nearly vertical) and TA tines 0.66 rad from vertical.
+//!
+//! Inverse kinematics runs on a private copy of the model from commanded
+//! joint positions only (what a robot's trajectory generator knows); the
+//! physical arm follows through its joint servos.
+
+use mujoco_rs::prelude::*;
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+use crate::error::KinovaError;
+use crate::model::SceneIds;
+
+/// One skewering action.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Action {
+    /// Label (VS0 ... TA90), the `FEEDING_ACTIONS` order of hil-core.
+    pub name: &'static str,
+    /// Fork pitch β (rad).
+    pub pitch: f64,
+    /// Tine-row angle to the major axis (rad).
+    pub roll: f64,
+    /// Force threshold ending penetration (N).
+    pub max_force: f64,
+}
+
+/// The six actions in hil-core's arm order: VS0 VS90 TV0 TV90 TA0 TA90.
+pub const ACTIONS: [Action; 6] = [
+    Action {
+        name: "VS0",
+        pitch: 0.0,
+        roll: 0.0,
+        max_force: 25.0,
+    },
+    Action {
+        name: "VS90",
+        pitch: 0.0,
+        roll: std::f64::consts::FRAC_PI_2,
+        max_force: 25.0,
+    },
+    Action {
+        name: "TV0",
+        pitch: -0.5,
+        roll: 0.0,
+        max_force: 20.0,
+    },
+    Action {
+        name: "TV90",
+        pitch: -0.5,
+        roll: std::f64::consts::FRAC_PI_2,
+        max_force: 20.0,
+    },
+    Action {
+        name: "TA0",
+        pitch: 0.4,
+        roll: 0.0,
+        max_force: 10.0,
+    },
+    Action {
+        name: "TA90",
+        pitch: 0.4,
+        roll: std::f64::consts::FRAC_PI_2,
+        max_force: 10.0,
+    },
+];
+
+/// Curvature of the tines towards the fork's +z (rad), from the MJCF.
+pub const TINE_CURVE: f64 = 0.262;
+
+/// Desired orientation of the fork base for a tine row at yaw `psi`: x (the
+/// handle at β = 0) straight down, y (across the tine row) horizontal.
+pub fn fork_base_orientation(psi: f64) -> Matrix3<f64> {
+    let x = Vector3::new(0.0, 0.0, -1.0);
+    let y = Vector3::new(psi.cos(), psi.sin(), 0.0);
+    let z = x.cross(&y);
+    Matrix3::from_columns(&[x, y, z])
+}
+
+/// Direction of the tines (root to tip) for pitch `beta` and row yaw `psi`.
+pub fn tine_direction(beta: f64, psi: f64) -> Vector3<f64> {
+    let r = fork_base_orientation(psi);
+    let a = beta + TINE_CURVE;
+    // Rotating the handle about the pitch axis tilts x towards +z.
+    r * Vector3::new(a.cos(), 0.0, a.sin())
+}
+
+/// Kinematics of the arm on a private copy of the model.
+#[derive(Debug)]
+pub struct Kinematics {
+    data: MjData<Box<MjModel>>,
+    ids: SceneIds,
+    jacp: Vec<f64>,
+    jacr: Vec<f64>,
+}
+
+/// A pose target for the tip: position of the tine-tip centre and
+/// orientation of the fork base.
+#[derive(Clone, Copy, Debug)]
+pub struct PoseTarget {
+    /// Tine-tip centre (world).
+    pub tip: Vector3<f64>,
+    /// Fork base orientation (world).
+    pub base: Matrix3<f64>,
+}
+
+impl Kinematics {
+    /// Kinematics on a copy of `model`.
+    pub fn new(model: Box<MjModel>, ids: SceneIds) -> Self {
+        let nv = model.ffi().nv as usize;
+        Self {
+            data: MjData::new(model),
+            ids,
+            jacp: vec![0.0; 3 * nv],
+            jacr: vec![0.0; 3 * nv],
+        }
+    }
+
+    /// Forward kinematics: sets the arm and fork joints and returns the
+    /// tine-tip centre position and the fork base orientation.
+    pub fn forward(&mut self, q: &[f64; 6], fork: [f64; 2]) -> (Vector3<f64>, Matrix3<f64>) {
+        {
+            let qpos = self.data.qpos_mut();
+            for i in 0..6 {
+                qpos[self.ids.arm_qpos[i]] = q[i];
+            }
+            qpos[self.ids.fork_qpos[0]] = fork[0];
+            qpos[self.ids.fork_qpos[1]] = fork[1];
+        }
+        self.data.kinematics();
+        self.data.com_pos();
+        (
+            self.site_pos(self.ids.tip_site),
+            self.site_rot(self.ids.wrist_site),
+        )
+    }
+
+    /// Position of a body's frame after the last [`forward`](Self::forward).
+    pub fn body_pos(&self, body: usize) -> Vector3<f64> {
+        Vector3::from(self.data.xpos()[body])
+    }
+
+    /// Position of a site after the last [`forward`](Self::forward).
+    pub fn site_pos(&self, site: usize) -> Vector3<f64> {
+        Vector3::from(self.data.site_xpos()[site])
+    }
+
+    /// Orientation of a site after the last [`forward`](Self::forward).
+    pub fn site_rot(&self, site: usize) -> Matrix3<f64> {
+        Matrix3::from_row_slice(&self.data.site_xmat()[site])
+    }
+
+    /// One damped-least-squares step from `q` towards `target`; returns the
+    /// new joints and the remaining error norm before the step.
+    pub fn dls_step(
+        &mut self,
+        q: &[f64; 6],
+        fork: [f64; 2],
+        target: &PoseTarget,
+        max_step: f64,
+    ) -> ([f64; 6], f64) {
+        let (p, r) = self.forward(q, fork);
+        let ep = target.tip - p;
+        let mut er = Vector3::zeros();
+        for c in 0..3 {
+            er += 0.5 * r.column(c).cross(&target.base.column(c));
+        }
+        let e = Vector6::new(ep.x, ep.y, ep.z, er.x, er.y, er.z);
+        let err = ep.norm() + er.norm();
+        self.jacobians();
+        let nv = self.jacp.len() / 3;
+        let mut j = Matrix6::zeros();
+        for (col, &dof) in self.ids.arm_dof.iter().enumerate() {
+            for row in 0..3 {
+                j[(row, col)] = self.jacp[row * nv + dof];
+                j[(row + 3, col)] = self.jacr[row * nv + dof];
+            }
+        }
+        let lambda2 = 1e-4;
+        let jjt = j * j.transpose() + Matrix6::identity() * lambda2;
+        let dq = match jjt.try_inverse() {
+            Some(inv) => j.transpose() * inv * e,
+            None => Vector6::zeros(),
+        };
+        let scale = (max_step / dq.amax().max(1e-12)).min(1.0);
+        let mut out = *q;
+        for i in 0..6 {
+            out[i] += scale * dq[i];
+        }
+        clamp_limits(&mut out);
+        (out, err)
+    }
+
+    fn jacobians(&mut self) {
+        // mj_jacSite writes 3×nv row-major blocks for the tip (position) and
+        // the wrist (rotation is the same for every point on the chain).
+        let (jp, _) = self.data.jac_site(true, false, self.ids.tip_site);
+        let (_, jr) = self.data.jac_site(false, true, self.ids.wrist_site);
+        self.jacp.copy_from_slice(&jp);
+        self.jacr.copy_from_slice(&jr);
+    }
+
+    /// Solves for joints reaching `target` from `seed`.
+    pub fn solve(
+        &mut self,
+        seed: &[f64; 6],
+        fork: [f64; 2],
+        target: &PoseTarget,
+        what: &str,
+    ) -> Result<[f64; 6], KinovaError> {
+        let mut q = *seed;
+        let mut err = f64::INFINITY;
+        for _ in 0..300 {
+            let (next, e) = self.dls_step(&q, fork, target, 0.2);
+            err = e;
+            if e < 1e-5 {
+                return Ok(q);
+            }
+            q = next;
+        }
+        if err < 1e-3 {
+            Ok(q)
+        } else {
+            Err(KinovaError::IkFailed {
+                what: what.into(),
+                residual: err,
+            })
+        }
+    }
+}
+
+/// Joint limits of joints 2, 3 and 5 (fact sheet, K2).
+fn clamp_limits(q: &mut [f64; 6]) {
+    q[1] = q[1].clamp(-2.24, 2.24);
+    q[2] = q[2].clamp(-2.57, 2.57);
+    q[4] = q[4].clamp(-2.09, 2.09);
+}
+
+/// Minimum-jerk interpolation weight for `t` in [0, 1].
+pub fn min_jerk(t: f64) -> f64 {
+    let t = t.clamp(0.0, 1.0);
+    t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
+}

@@ -1,0 +1,409 @@
+//! [`KinovaFeedingEnv`]: the MuJoCo feeding simulation as a
+//! `hil_core::Environment`, and its config type `kinova_feeding`.
+//!
+//! ```
+//! use hil_core::Environment;
+//! use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
+//!
+//! let mut env = KinovaFeedingEnv::new(KinovaFeedingConfig::default())?;
+//! env.reset(7)?;
+//! while let Some(item) = env.next_item()? {
+//!     let x = env.observe()?;
+//!     let out = env.execute(hil_core::ArmId(4))?; // TA0
+//!     println!("{}: {} (context dim {})", item.label, out.success, x.dim());
+//! }
+//! # Ok::<(), hil_core::HilError>(())
+//! ```
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use hil_core::config::{BuildContext, EnvironmentConfig};
+use hil_core::{
+    ActionSpace, ArmId, Context, Environment, HilError, Item, LabelledObservation, Outcome, Result,
+};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::controller::ACTIONS;
+use crate::food::{FoodKind, FoodModel, FoodProps};
+use crate::model::MjcfSource;
+use crate::perception::{Embedding, Observation, PerceptionNoise, perceive};
+use crate::sim::{AttemptReport, KeyframeHook, Placement, Simulator};
+
+/// Configuration of [`KinovaFeedingEnv`] (`type = "kinova_feeding"`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KinovaFeedingConfig {
+    /// The items of one episode, in order (`banana`, `carrot`, `cantaloupe`).
+    #[serde(default = "default_plate")]
+    pub plate: Vec<String>,
+    /// Dimension of the contexts.
+    #[serde(default = "default_dim")]
+    pub context_dim: usize,
+    /// Seed of the fixed feature embedding.
+    #[serde(default)]
+    pub embedding_seed: u64,
+    /// Place the episode's other remaining items on the plate too.
+    #[serde(default = "yes")]
+    pub neighbours: bool,
+    /// A custom scene (MJCF) instead of the built-in one.
+    #[serde(default)]
+    pub mjcf: Option<PathBuf>,
+    /// Perception noise.
+    #[serde(default)]
+    pub noise: PerceptionNoise,
+    /// Simulated attempts per (food, action) offered to policies as
+    /// pretraining data (`pretrain = true` in their configs); 0 offers none.
+    /// They are drawn from the plate's own foods on a separate seed stream
+    /// (the paper pretrained on other foods, which this scene lacks).
+    #[serde(default)]
+    pub pretraining_trials: usize,
+}
+
+fn default_plate() -> Vec<String> {
+    FoodKind::ALL.iter().map(|k| k.name().to_string()).collect()
+}
+fn default_dim() -> usize {
+    32
+}
+fn yes() -> bool {
+    true
+}
+
+impl Default for KinovaFeedingConfig {
+    fn default() -> Self {
+        Self {
+            plate: default_plate(),
+            context_dim: default_dim(),
+            embedding_seed: 0,
+            neighbours: true,
+            mjcf: None,
+            noise: PerceptionNoise::default(),
+            pretraining_trials: 0,
+        }
+    }
+}
+
+impl KinovaFeedingConfig {
+    fn foods(&self) -> Result<Vec<FoodKind>> {
+        if self.plate.is_empty() {
+            return Err(HilError::invalid_parameter(
+                "plate",
+                "[]",
+                "needs at least one item",
+            ));
+        }
+        self.plate
+            .iter()
+            .map(|s| {
+                FoodKind::parse(s).ok_or_else(|| {
+                    HilError::invalid_parameter(
+                        "plate",
+                        format!("{s:?}"),
+                        "unknown food; expected banana, carrot or cantaloupe",
+                    )
+                })
+            })
+            .collect()
+    }
+
+    fn validate(&self) -> Result<()> {
+        self.foods()?;
+        if self.context_dim == 0 || self.context_dim > 4096 {
+            return Err(HilError::invalid_parameter(
+                "context_dim",
+                self.context_dim.to_string(),
+                "must be in 1..=4096",
+            ));
+        }
+        let n = &self.noise;
+        for (name, v) in [
+            ("noise.position_m", n.position_m),
+            ("noise.yaw_rad", n.yaw_rad),
+            ("noise.size_rel", n.size_rel),
+            ("noise.colour", n.colour),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(HilError::invalid_parameter(
+                    name,
+                    v.to_string(),
+                    "must be finite and ≥ 0",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[typetag::serde(name = "kinova_feeding")]
+impl EnvironmentConfig for KinovaFeedingConfig {
+    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Environment>> {
+        let mut cfg = self.clone();
+        cfg.mjcf = cfg.mjcf.map(|p| ctx.resolve(&p));
+        Ok(Box::new(KinovaFeedingEnv::new(cfg)?))
+    }
+
+    fn pretraining(&self, ctx: &BuildContext) -> Result<Option<Arc<[LabelledObservation]>>> {
+        if self.pretraining_trials == 0 {
+            return Ok(None);
+        }
+        let mut cfg = self.clone();
+        cfg.mjcf = cfg.mjcf.map(|p| ctx.resolve(&p));
+        Ok(Some(simulated_pretraining(&cfg, ctx.seed)?.into()))
+    }
+}
+
+/// Seed stream of pretraining attempts (kept apart from episode seeds).
+const PRETRAIN_STREAM: u64 = 0x7072_6574_7261_696e;
+
+/// Runs `cfg.pretraining_trials` attempts of every action on every distinct
+/// food of the plate and returns them as labelled observations.
+pub fn simulated_pretraining(
+    cfg: &KinovaFeedingConfig,
+    seed: u64,
+) -> Result<Vec<LabelledObservation>> {
+    let mut foods = cfg.foods()?;
+    foods.sort();
+    foods.dedup();
+    let mut out = Vec::new();
+    for food in foods {
+        let mut env = KinovaFeedingEnv::new(KinovaFeedingConfig {
+            plate: vec![food.name().to_string()],
+            neighbours: false,
+            pretraining_trials: 0,
+            ..cfg.clone()
+        })?;
+        for arm in 0..ACTIONS.len() {
+            for t in 0..cfg.pretraining_trials {
+                let stream = (food.index() * ACTIONS.len() + arm) * cfg.pretraining_trials + t;
+                env.reset(hil_core::session::splitmix(
+                    seed ^ PRETRAIN_STREAM,
+                    stream as u64,
+                ))?;
+                env.next_item()?;
+                let context = env.observe()?;
+                let reward = env.execute(ArmId(arm))?.reward();
+                out.push(LabelledObservation {
+                    context,
+                    arm: ArmId(arm),
+                    reward,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+#[derive(Debug)]
+struct Current {
+    item: Item,
+    props: FoodProps,
+    observation: Option<Observation>,
+}
+
+/// The Kinova Gen3 feeding simulation as an [`Environment`].
+///
+/// Each item is a freshly drawn piece of the configured food; each
+/// `observe` places it (and the episode's remaining items) on the plate at
+/// random, lets them settle and perceives the target; `execute` runs the
+/// action through the controller and physics. `best_action` is the
+/// published best action for the food (what an informed caregiver names).
+#[derive(Debug)]
+pub struct KinovaFeedingEnv {
+    cfg: KinovaFeedingConfig,
+    foods: Vec<FoodKind>,
+    models: Vec<FoodModel>,
+    sim: Simulator,
+    embedding: Embedding,
+    actions: ActionSpace,
+    rng: ChaCha8Rng,
+    cursor: usize,
+    current: Option<Current>,
+    last: Option<AttemptReport>,
+}
+
+impl KinovaFeedingEnv {
+    /// Builds the environment (loads the MJCF).
+    pub fn new(cfg: KinovaFeedingConfig) -> Result<Self> {
+        cfg.validate()?;
+        let sim = match &cfg.mjcf {
+            Some(p) => Simulator::from_source(MjcfSource::File(p))?,
+            None => Simulator::new()?,
+        };
+        Ok(Self {
+            foods: cfg.foods()?,
+            models: FoodKind::ALL
+                .iter()
+                .map(|&k| FoodModel::default_for(k))
+                .collect(),
+            embedding: Embedding::new(cfg.context_dim, cfg.embedding_seed),
+            sim,
+            actions: ActionSpace::feeding(),
+            rng: ChaCha8Rng::seed_from_u64(0),
+            cursor: 0,
+            current: None,
+            last: None,
+            cfg,
+        })
+    }
+
+    /// The simulator (for rendering and timing).
+    pub fn simulator(&self) -> &Simulator {
+        &self.sim
+    }
+
+    /// Details of the last executed attempt.
+    pub fn last_attempt(&self) -> Option<&AttemptReport> {
+        self.last.as_ref()
+    }
+
+    /// Like [`Environment::execute`], calling `keyframe` at each phase.
+    pub fn execute_with(
+        &mut self,
+        arm: ArmId,
+        keyframe: Option<KeyframeHook<'_>>,
+    ) -> Result<Outcome> {
+        self.actions.check(arm)?;
+        let cur = self
+            .current
+            .as_mut()
+            .ok_or_else(|| HilError::state("kinova_feeding", "execute called before next_item"))?;
+        let obs = cur.observation.take().ok_or_else(|| {
+            HilError::state("kinova_feeding", "execute called without a fresh observe")
+        })?;
+        let report = self.sim.execute(&ACTIONS[arm.0], &obs.target, keyframe)?;
+        let success = report.success;
+        self.last = Some(report);
+        Ok(Outcome {
+            success,
+            success_probability: None,
+        })
+    }
+
+    fn place(&mut self, target: &FoodProps) -> Vec<Placement> {
+        let mut items = vec![target.clone()];
+        if self.cfg.neighbours {
+            for &k in &self.foods[self.cursor..] {
+                if items.iter().all(|p| p.kind != k) {
+                    items.push(self.models[k.index()].sample(&mut self.rng));
+                }
+            }
+        }
+        let mut placed: Vec<Placement> = Vec::new();
+        for props in items {
+            let r = props.shape.half_extents()[0];
+            let mut xy = [0.0, 0.0];
+            for _ in 0..200 {
+                let rad = (0.085 - r).max(0.0) * self.rng.random::<f64>().sqrt();
+                let a = self.rng.random_range(0.0..std::f64::consts::TAU);
+                xy = [rad * a.cos(), rad * a.sin()];
+                let clear = placed.iter().all(|p| {
+                    let d = ((p.xy[0] - xy[0]).powi(2) + (p.xy[1] - xy[1]).powi(2)).sqrt();
+                    d > r + p.props.shape.half_extents()[0] + 0.006
+                });
+                if clear {
+                    break;
+                }
+            }
+            let yaw = self
+                .rng
+                .random_range(-std::f64::consts::PI..std::f64::consts::PI);
+            placed.push(Placement { props, xy, yaw });
+        }
+        placed
+    }
+}
+
+impl Environment for KinovaFeedingEnv {
+    fn name(&self) -> &str {
+        "kinova_feeding"
+    }
+
+    fn action_space(&self) -> &ActionSpace {
+        &self.actions
+    }
+
+    fn context_dim(&self) -> usize {
+        self.embedding.dim()
+    }
+
+    fn reset(&mut self, seed: u64) -> Result<()> {
+        self.rng = ChaCha8Rng::seed_from_u64(seed);
+        self.cursor = 0;
+        self.current = None;
+        self.last = None;
+        Ok(())
+    }
+
+    fn next_item(&mut self) -> Result<Option<Item>> {
+        let Some(&kind) = self.foods.get(self.cursor) else {
+            self.current = None;
+            return Ok(None);
+        };
+        let props = self.models[kind.index()].sample(&mut self.rng);
+        let item = Item {
+            index: self.cursor,
+            label: kind.name().to_string(),
+            description: Some(format!("a {} on the plate", kind.name())),
+        };
+        self.cursor += 1;
+        self.current = Some(Current {
+            item: item.clone(),
+            props,
+            observation: None,
+        });
+        Ok(Some(item))
+    }
+
+    fn observe(&mut self) -> Result<Context> {
+        let props = match &self.current {
+            Some(c) => c.props.clone(),
+            None => {
+                return Err(HilError::state(
+                    "kinova_feeding",
+                    "observe called before next_item",
+                ));
+            }
+        };
+        // Items already eaten are gone; the current one is `cursor - 1`.
+        self.cursor -= 1;
+        let placed = self.place(&props);
+        self.cursor += 1;
+        let poses = self.sim.stage(&placed, props.kind)?;
+        let target = poses
+            .iter()
+            .position(|p| p.kind == props.kind)
+            .ok_or_else(|| HilError::state("kinova_feeding", "target missing after staging"))?;
+        let plate = self.sim.plate_top_centre();
+        let obs = perceive(
+            &poses,
+            target,
+            &props.shape,
+            props.colour,
+            [plate.x, plate.y],
+            &self.cfg.noise,
+            &mut self.rng,
+        );
+        let x = Context::new(self.embedding.embed(&obs.raw))?;
+        if let Some(c) = self.current.as_mut() {
+            c.observation = Some(obs);
+        }
+        Ok(x)
+    }
+
+    fn execute(&mut self, arm: ArmId) -> Result<Outcome> {
+        self.execute_with(arm, None)
+    }
+
+    fn best_action(&self) -> Option<ArmId> {
+        self.current
+            .as_ref()
+            .map(|c| ArmId(c.props.kind.expert_action()))
+    }
+
+    fn current_item(&self) -> Option<&Item> {
+        self.current.as_ref().map(|c| &c.item)
+    }
+}

@@ -1,0 +1,70 @@
+//! Errors of the MuJoCo feeding simulation.
+
+use std::path::PathBuf;
+
+use hil_core::HilError;
+
+/// What can go wrong while loading or running the simulation.
+#[derive(Debug, thiserror::Error)]
+pub enum KinovaError {
+    /// The MJCF file does not exist or cannot be read.
+    #[error("MJCF file {}: {source}", path.display())]
+    MjcfUnreadable {
+        /// The file concerned.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// MuJoCo rejected the MJCF (its message names the line and element).
+    #[error("MJCF {origin}: MuJoCo could not load the model: {why}")]
+    MjcfMalformed {
+        /// File path, or `<built-in>`.
+        origin: String,
+        /// MuJoCo's message.
+        why: String,
+    },
+    /// The model loads but lacks an element the simulation needs.
+    #[error("MJCF {origin}: missing {kind} `{name}` (the feeding scene needs it)")]
+    MjcfMissing {
+        /// File path, or `<built-in>`.
+        origin: String,
+        /// Element kind (`body`, `joint`, `site`, ...).
+        kind: &'static str,
+        /// The name looked up.
+        name: String,
+    },
+    /// An element exists but has the wrong shape (e.g. a food geom of the wrong type).
+    #[error("MJCF {origin}: {what}")]
+    MjcfInvalid {
+        /// File path, or `<built-in>`.
+        origin: String,
+        /// What is wrong.
+        what: String,
+    },
+    /// The physics diverged (non-finite state).
+    #[error("simulation diverged at t = {time:.3} s during {phase}")]
+    Diverged {
+        /// Simulated time of the failure.
+        time: f64,
+        /// The controller phase.
+        phase: &'static str,
+    },
+    /// Inverse kinematics found no joint configuration for a target pose.
+    #[error("inverse kinematics failed for {what}: residual {residual:.4}")]
+    IkFailed {
+        /// The target concerned.
+        what: String,
+        /// Remaining pose error (m + rad).
+        residual: f64,
+    },
+}
+
+impl From<KinovaError> for HilError {
+    fn from(e: KinovaError) -> Self {
+        HilError::Backend {
+            backend: "mujoco".into(),
+            why: e.to_string(),
+        }
+    }
+}

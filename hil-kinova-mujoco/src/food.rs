@@ -1,0 +1,379 @@
+//! Food kinds, their randomised physical properties and shapes, and the
+//! published per-action success rates the simulation is calibrated against.
+//!
+//! No source publishes stiffness, puncture force per tine or item sizes (see
+//! the fact sheet, section 4); the distributions below are assumptions,
+//! chosen from everyday sizes (a 3 cm banana slice, a 1.7 cm thick baby
+//! carrot, a 2.5 cm melon cube) and the per-food force thresholds of the ADA
+//! feeding stack (banana 6.1 N, carrot 22.5 N, cantaloupe 7.4 N whole-fork),
+//! then tuned by `hil kinova calibrate` so that simulated success rates come
+//! close to the published table.
+
+use nalgebra::Vector3;
+use rand::Rng;
+use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
+
+/// A kind of food the scene holds (one MuJoCo body each).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
+#[serde(rename_all = "snake_case")]
+pub enum FoodKind {
+    /// A banana slice: soft, slippery disc.
+    Banana,
+    /// A baby carrot: hard, elongated.
+    Carrot,
+    /// A cantaloupe cube: medium, juicy.
+    Cantaloupe,
+}
+
+impl FoodKind {
+    /// Every kind, in scene order.
+    pub const ALL: [FoodKind; 3] = [FoodKind::Banana, FoodKind::Carrot, FoodKind::Cantaloupe];
+
+    /// The label used in items, configs and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            FoodKind::Banana => "banana",
+            FoodKind::Carrot => "carrot",
+            FoodKind::Cantaloupe => "cantaloupe",
+        }
+    }
+
+    /// Parses a label (`banana`, `carrot`, `cantaloupe`).
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == s)
+    }
+
+    /// Index in [`FoodKind::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Name of the item's body in the MJCF.
+    pub fn body_name(self) -> String {
+        format!("food_{}", self.name())
+    }
+
+    /// Name of the item's geom in the MJCF.
+    pub fn geom_name(self) -> String {
+        format!("food_{}_geom", self.name())
+    }
+
+    /// Published success rates (Feng et al. 2019, setting `all`) in the
+    /// order VS0 VS90 TV0 TV90 TA0 TA90.
+    pub fn published_rates(self) -> [f64; 6] {
+        match self {
+            FoodKind::Banana => [0.2, 0.2, 0.1, 0.1, 0.57, 0.57],
+            FoodKind::Carrot => [0.0, 0.53, 0.0, 0.43, 0.0, 0.03],
+            FoodKind::Cantaloupe => [0.77, 0.93, 0.7, 0.8, 0.3, 0.27],
+        }
+    }
+
+    /// The action a knowledgeable caregiver names for this food: the best
+    /// published action (ties broken towards the lower index).
+    pub fn expert_action(self) -> usize {
+        let r = self.published_rates();
+        (0..6).fold(0, |b, i| if r[i] > r[b] { i } else { b })
+    }
+
+    /// Nominal colour (RGB in [0, 1]) a camera sees.
+    pub fn colour(self) -> [f64; 3] {
+        match self {
+            FoodKind::Banana => [0.96, 0.92, 0.62],
+            FoodKind::Carrot => [0.95, 0.50, 0.12],
+            FoodKind::Cantaloupe => [0.98, 0.66, 0.38],
+        }
+    }
+}
+
+/// The geometry of one item, in its body frame (+x is the major axis).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Shape {
+    /// Disc lying flat: radius, half height.
+    Disc {
+        /// Radius (m).
+        radius: f64,
+        /// Half of the thickness (m).
+        half_height: f64,
+    },
+    /// Capsule lying along x: radius, half length of the straight part.
+    Capsule {
+        /// Radius (m).
+        radius: f64,
+        /// Half length of the cylindrical part (m).
+        half_length: f64,
+    },
+    /// Box: half sizes along x, y, z.
+    Cuboid {
+        /// Half sizes (m).
+        half: [f64; 3],
+    },
+}
+
+impl Shape {
+    /// Whether the point `p` (body frame) lies inside the item.
+    pub fn contains(&self, p: &Vector3<f64>) -> bool {
+        match *self {
+            Shape::Disc {
+                radius,
+                half_height,
+            } => p.z.abs() <= half_height && p.x * p.x + p.y * p.y <= radius * radius,
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => {
+                let cx = p.x.clamp(-half_length, half_length);
+                (p.x - cx).powi(2) + p.y * p.y + p.z * p.z <= radius * radius
+            }
+            Shape::Cuboid { half } => {
+                p.x.abs() <= half[0] && p.y.abs() <= half[1] && p.z.abs() <= half[2]
+            }
+        }
+    }
+
+    /// Half extents of the axis-aligned bounding box (x major, y minor, z height).
+    pub fn half_extents(&self) -> [f64; 3] {
+        match *self {
+            Shape::Disc {
+                radius,
+                half_height,
+            } => [radius, radius, half_height],
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => [half_length + radius, radius, radius],
+            Shape::Cuboid { half } => half,
+        }
+    }
+
+    /// Radius of the bounding sphere.
+    pub fn bounding_radius(&self) -> f64 {
+        let h = self.half_extents();
+        (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt()
+    }
+
+    /// Volume (m³).
+    pub fn volume(&self) -> f64 {
+        use std::f64::consts::PI;
+        match *self {
+            Shape::Disc {
+                radius,
+                half_height,
+            } => PI * radius * radius * 2.0 * half_height,
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => PI * radius * radius * 2.0 * half_length + 4.0 / 3.0 * PI * radius.powi(3),
+            Shape::Cuboid { half } => 8.0 * half[0] * half[1] * half[2],
+        }
+    }
+
+    /// Diagonal inertia about the centre for mass `m` (approximating the
+    /// capsule as a cylinder of its full length).
+    pub fn inertia(&self, m: f64) -> [f64; 3] {
+        match *self {
+            Shape::Disc {
+                radius,
+                half_height,
+            } => {
+                let h = 2.0 * half_height;
+                let ixy = m * (3.0 * radius * radius + h * h) / 12.0;
+                [ixy, ixy, m * radius * radius / 2.0]
+            }
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => {
+                let l = 2.0 * (half_length + radius);
+                let iyz = m * (3.0 * radius * radius + l * l) / 12.0;
+                [m * radius * radius / 2.0, iyz, iyz]
+            }
+            Shape::Cuboid { half } => {
+                let [a, b, c] = half.map(|h| 2.0 * h);
+                [
+                    m * (b * b + c * c) / 12.0,
+                    m * (a * a + c * c) / 12.0,
+                    m * (a * a + b * b) / 12.0,
+                ]
+            }
+        }
+    }
+}
+
+/// The mechanical properties of one item, drawn per item.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FoodProps {
+    /// The kind.
+    pub kind: FoodKind,
+    /// Geometry.
+    pub shape: Shape,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Force one tine needs to break the surface (N).
+    pub puncture_force: f64,
+    /// Surface stiffness under one tine before it breaks through (N/m).
+    pub indent_stiffness: f64,
+    /// Resistance to a tine advancing after puncture (N per tine).
+    pub cut_resistance: f64,
+    /// Axial grip of the flesh on an embedded tine (N per metre embedded).
+    pub grip_per_m: f64,
+    /// Friction coefficient turning lateral bearing load into axial grip.
+    pub friction: f64,
+    /// Lateral load the flesh bears before a tine tears out (N per metre embedded).
+    pub tear_per_m: f64,
+    /// Sideways slot a tine may cut before it tears out (m).
+    pub cut_limit: f64,
+    /// True colour (RGB).
+    pub colour: [f64; 3],
+}
+
+/// Parameters of the per-kind property distributions (means and relative
+/// spreads); the calibration knobs of the skewering model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FoodModel {
+    /// Which kind this describes.
+    pub kind: FoodKind,
+    /// Nominal dimensions (m): disc [radius, half height]; capsule [radius,
+    /// half length]; cuboid [half x, half y, half z].
+    pub dims: Vec<f64>,
+    /// Relative standard deviation of each dimension.
+    pub dims_rel_sd: f64,
+    /// Density (kg/m³).
+    pub density: f64,
+    /// Mean puncture force per tine (N) and its relative standard deviation.
+    pub puncture_force: (f64, f64),
+    /// Indentation (m) at which a tine breaks through, on average.
+    pub puncture_indent: f64,
+    /// Cutting resistance as a fraction of the puncture force.
+    pub cut_fraction: f64,
+    /// Mean axial grip (N/m) and relative sd.
+    pub grip_per_m: (f64, f64),
+    /// Friction coefficient (mean, relative sd).
+    pub friction: (f64, f64),
+    /// Mean tear strength (N/m) and relative sd.
+    pub tear_per_m: (f64, f64),
+    /// Sideways slot before a tine tears out, as a fraction of the item's
+    /// minor half-extent.
+    pub cut_fraction_of_width: f64,
+}
+
+impl FoodModel {
+    /// The built-in (calibrated) model of `kind`.
+    pub fn default_for(kind: FoodKind) -> Self {
+        match kind {
+            FoodKind::Banana => FoodModel {
+                kind,
+                dims: vec![0.0150, 0.0055],
+                dims_rel_sd: 0.10,
+                density: 950.0,
+                puncture_force: (0.5, 0.3),
+                puncture_indent: 0.002,
+                cut_fraction: 0.3,
+                grip_per_m: (1.0, 0.5),
+                friction: (0.5, 0.3),
+                tear_per_m: (15.0, 0.3),
+                cut_fraction_of_width: 0.3,
+            },
+            FoodKind::Carrot => FoodModel {
+                kind,
+                dims: vec![0.0085, 0.020],
+                dims_rel_sd: 0.10,
+                density: 1030.0,
+                puncture_force: (7.5, 0.12),
+                puncture_indent: 0.0022,
+                cut_fraction: 0.25,
+                grip_per_m: (20.0, 0.3),
+                friction: (0.8, 0.2),
+                tear_per_m: (1500.0, 0.3),
+                cut_fraction_of_width: 0.5,
+            },
+            FoodKind::Cantaloupe => FoodModel {
+                kind,
+                dims: vec![0.0135, 0.0125, 0.0120],
+                dims_rel_sd: 0.08,
+                density: 930.0,
+                puncture_force: (2.9, 0.2),
+                puncture_indent: 0.002,
+                cut_fraction: 0.25,
+                grip_per_m: (3.0, 0.5),
+                friction: (0.8, 0.3),
+                tear_per_m: (200.0, 0.3),
+                cut_fraction_of_width: 0.4,
+            },
+        }
+    }
+
+    /// Draws one item.
+    pub fn sample(&self, rng: &mut impl Rng) -> FoodProps {
+        let mut pos = |mean: f64, rel: f64| -> f64 {
+            let n = Normal::new(0.0, 1.0).expect("unit normal");
+            let z: f64 = n.sample(rng);
+            // Truncate at ±2.5 sd so no property turns non-physical.
+            (mean * (1.0 + rel * z.clamp(-2.5, 2.5))).max(mean * 0.05)
+        };
+        let d: Vec<f64> = self
+            .dims
+            .iter()
+            .map(|&m| pos(m, self.dims_rel_sd))
+            .collect();
+        let shape = match self.kind {
+            FoodKind::Banana => Shape::Disc {
+                radius: d[0],
+                half_height: d[1],
+            },
+            FoodKind::Carrot => Shape::Capsule {
+                radius: d[0],
+                half_length: d[1],
+            },
+            FoodKind::Cantaloupe => {
+                // Keep +x the longest side: it is the major axis.
+                let mut h = [d[0], d[1], d[2]];
+                if h[1] > h[0] {
+                    h.swap(0, 1);
+                }
+                Shape::Cuboid { half: h }
+            }
+        };
+        let puncture_force = pos(self.puncture_force.0, self.puncture_force.1);
+        FoodProps {
+            kind: self.kind,
+            mass: shape.volume() * self.density,
+            shape,
+            puncture_force,
+            indent_stiffness: puncture_force / self.puncture_indent,
+            cut_resistance: puncture_force * self.cut_fraction,
+            grip_per_m: pos(self.grip_per_m.0, self.grip_per_m.1),
+            friction: pos(self.friction.0, self.friction.1),
+            tear_per_m: pos(self.tear_per_m.0, self.tear_per_m.1),
+            cut_limit: self.cut_fraction_of_width * shape.half_extents()[1],
+            colour: self.kind.colour(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    #[test]
+    fn shapes_contain_their_centre_and_not_far_points() {
+        for kind in FoodKind::ALL {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+            let p = FoodModel::default_for(kind).sample(&mut rng);
+            assert!(p.shape.contains(&Vector3::zeros()));
+            assert!(!p.shape.contains(&Vector3::new(0.0, 0.0, 0.05)));
+            assert!(p.mass > 0.002 && p.mass < 0.03, "{kind:?} mass {}", p.mass);
+        }
+    }
+
+    #[test]
+    fn expert_actions_follow_the_published_table() {
+        assert_eq!(FoodKind::Banana.expert_action(), 4);
+        assert_eq!(FoodKind::Carrot.expert_action(), 1);
+        assert_eq!(FoodKind::Cantaloupe.expert_action(), 1);
+        assert_eq!(FoodKind::parse("carrot"), Some(FoodKind::Carrot));
+        assert_eq!(FoodKind::parse("kiwi"), None);
+    }
+}

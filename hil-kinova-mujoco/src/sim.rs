@@ -1,0 +1,581 @@
+//! One simulated attempt: place the items, let them settle, then run an
+//! action through the controller and the skewering model and judge it.
+
+use std::time::{Duration, Instant};
+
+use mujoco_rs::prelude::*;
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use serde::Serialize;
+
+use crate::controller::{
+    Action, Kinematics, PoseTarget, fork_base_orientation, min_jerk, tine_direction,
+};
+use crate::error::KinovaError;
+use crate::food::{FoodKind, FoodProps, Shape};
+use crate::model::{self, MjcfSource, N_TINES, SceneIds};
+use crate::skewer::{FoodView, SkewerModel, SkewerStats, TinePose, Wrench};
+
+/// Height of the plate's top surface above its body frame (m).
+const PLATE_TOP: f64 = 0.006;
+/// Approach starts this far back from the entry point along the tines (m).
+const PRE_OFFSET: f64 = 0.04;
+/// Deepest travel past the perceived top surface (m): ADA's Gen3 value.
+const DEPTH_LIMIT: f64 = 0.035;
+/// Lift height (m), as ADA's two 0.025 m moves plus margin.
+const LIFT: f64 = 0.06;
+/// How long the item must stay on the fork after the lift (s). The
+/// published rule is 5 s; slipping happens in the first second here, so a
+/// shorter hold keeps calibration fast (a stated approximation).
+const HOLD: f64 = 1.5;
+/// Smallest rotational inertia given to an item (kg·m²).
+const MIN_INERTIA: f64 = 3e-6;
+/// Item height above the plate that counts as lifted (m).
+const LIFTED: f64 = 0.03;
+
+/// One item on the plate: kind, properties and pose relative to the plate centre.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Placement {
+    /// The item.
+    pub props: FoodProps,
+    /// Position on the plate (m, plate frame).
+    pub xy: [f64; 2],
+    /// Yaw of the major axis (rad).
+    pub yaw: f64,
+}
+
+/// An item's true pose after settling.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct TruePose {
+    /// Kind.
+    pub kind: FoodKind,
+    /// Centre (world).
+    pub centre: [f64; 3],
+    /// Yaw of the major axis (rad).
+    pub yaw: f64,
+    /// Half extents (major, minor, height) (m).
+    pub half_extents: [f64; 3],
+}
+
+/// What the controller is told about the target: a noisy perceived pose.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PerceivedTarget {
+    /// Centre (world, m).
+    pub centre: [f64; 3],
+    /// Yaw of the major axis (rad).
+    pub yaw: f64,
+    /// Half height (m).
+    pub half_height: f64,
+}
+
+/// Why penetration ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopReason {
+    /// The wrist force reached the action's threshold.
+    Force,
+    /// The tines reached the depth limit.
+    Depth,
+}
+
+/// Everything measured during one attempt.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AttemptReport {
+    /// The action executed.
+    pub action: &'static str,
+    /// The food attempted.
+    pub food: FoodKind,
+    /// The item stayed on the fork through lift and hold.
+    pub success: bool,
+    /// Fork pitch reached before the approach (rad).
+    pub reached_pitch: f64,
+    /// Angle of the tine row to the perceived major axis before the approach (rad, in [0, π/2]).
+    pub reached_roll: f64,
+    /// Why penetration ended.
+    pub stop: StopReason,
+    /// Largest axial wrist force during penetration (N).
+    pub peak_force: f64,
+    /// Tine counters.
+    pub tines: SkewerStats,
+    /// Height of the item above the plate at the end (m).
+    pub final_height: f64,
+    /// Simulated time (s).
+    pub sim_time: f64,
+    /// Physics steps taken.
+    pub steps: u64,
+}
+
+/// Wall-clock accounting: total time in attempts and time inside `mj_step`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timing {
+    /// Time inside `mj_step`.
+    pub in_step: Duration,
+    /// Total time spent in `stage` and `execute`.
+    pub total: Duration,
+    /// Attempts executed.
+    pub attempts: u64,
+}
+
+/// Called with a phase name and the physics state at each keyframe.
+pub type KeyframeHook<'a> = &'a mut dyn FnMut(&str, &mut MjData<Box<MjModel>>);
+
+/// The MuJoCo simulation of the feeding scene.
+#[derive(Debug)]
+pub struct Simulator {
+    data: MjData<Box<MjModel>>,
+    ids: SceneIds,
+    kin: Kinematics,
+    home: [f64; 6],
+    plate_centre: Vector3<f64>,
+    props: [Option<FoodProps>; 3],
+    target: Option<FoodKind>,
+    dt: f64,
+    timing: Timing,
+}
+
+impl Simulator {
+    /// Loads the built-in scene.
+    pub fn new() -> Result<Self, KinovaError> {
+        Self::from_source(MjcfSource::Builtin)
+    }
+
+    /// Loads the scene from `source`.
+    pub fn from_source(source: MjcfSource<'_>) -> Result<Self, KinovaError> {
+        let (model, ids) = model::load(source)?;
+        let kin_model = Box::new(model.clone());
+        let model = Box::new(model);
+        let dt = model.opt().timestep;
+        let mut kin = Kinematics::new(kin_model, ids.clone());
+        let data = MjData::new(model);
+        let plate_centre = Vector3::from(data.xpos()[ids.plate_body]);
+        let plate_centre = if plate_centre == Vector3::zeros() {
+            // xpos is filled by the first forward pass; the body pos is static.
+            let mut d = MjData::new(Box::new(data.model().clone()));
+            d.forward();
+            Vector3::from(d.xpos()[ids.plate_body])
+        } else {
+            plate_centre
+        };
+        let home_target = PoseTarget {
+            tip: plate_centre + Vector3::new(0.0, 0.0, 0.15),
+            base: fork_base_orientation(0.0),
+        };
+        let seed = [0.0, 0.35, -2.0, 0.0, -0.9, std::f64::consts::FRAC_PI_2];
+        let home = kin.solve(&seed, [0.0, 0.0], &home_target, "home pose above the plate")?;
+        Ok(Self {
+            data,
+            ids,
+            kin,
+            home,
+            plate_centre,
+            props: [None, None, None],
+            target: None,
+            dt,
+            timing: Timing::default(),
+        })
+    }
+
+    /// Arm joint angles of the home pose.
+    pub fn home(&self) -> [f64; 6] {
+        self.home
+    }
+
+    /// Centre of the plate's top surface (world).
+    pub fn plate_top_centre(&self) -> Vector3<f64> {
+        self.plate_centre + Vector3::new(0.0, 0.0, PLATE_TOP)
+    }
+
+    /// The physics state.
+    pub fn data(&self) -> &MjData<Box<MjModel>> {
+        &self.data
+    }
+
+    /// The arm kinematics.
+    pub fn kinematics(&mut self) -> &mut Kinematics {
+        &mut self.kin
+    }
+
+    /// Model indices.
+    pub fn ids(&self) -> &SceneIds {
+        &self.ids
+    }
+
+    /// Wall-clock accounting so far.
+    pub fn timing(&self) -> Timing {
+        self.timing
+    }
+
+    /// Places `items` on the plate (at most one per kind; the others are put
+    /// aside), lets them settle, and returns their true poses.
+    pub fn stage(
+        &mut self,
+        items: &[Placement],
+        target: FoodKind,
+    ) -> Result<Vec<TruePose>, KinovaError> {
+        let start = Instant::now();
+        let mut props: [Option<FoodProps>; 3] = [None, None, None];
+        for p in items {
+            if props[p.props.kind.index()].is_some() {
+                return Err(KinovaError::MjcfInvalid {
+                    origin: "scene".into(),
+                    what: format!(
+                        "the scene has one body per food kind; {} appears twice",
+                        p.props.kind.name()
+                    ),
+                });
+            }
+            props[p.props.kind.index()] = Some(p.props.clone());
+        }
+        if props[target.index()].is_none() {
+            return Err(KinovaError::MjcfInvalid {
+                origin: "scene".into(),
+                what: format!("target {} is not on the plate", target.name()),
+            });
+        }
+        for kind in FoodKind::ALL {
+            if let Some(p) = &props[kind.index()] {
+                self.apply_props(kind, p);
+            }
+        }
+        // Recompute the model constants that depend on masses and inertias
+        // (constraint scaling uses them).
+        // SAFETY: model and data belong together; mj_setConst only writes
+        // constant fields of the model and scratch fields of the data.
+        unsafe {
+            let d: *mut mujoco_rs::mujoco_c::mjData = self.data.ffi_mut();
+            let m: *mut mujoco_rs::mujoco_c::mjModel = self.data.model_mut().ffi_mut();
+            mujoco_rs::mujoco_c::mj_setConst(m, d);
+        }
+        self.data.reset();
+        {
+            let home = self.home;
+            let ids = self.ids.clone();
+            let qpos = self.data.qpos_mut();
+            for i in 0..6 {
+                qpos[ids.arm_qpos[i]] = home[i];
+            }
+            for kind in FoodKind::ALL {
+                let f = ids.food[kind.index()];
+                let (pos, yaw) = match items.iter().find(|p| p.props.kind == kind) {
+                    Some(p) => {
+                        let h = p.props.shape.half_extents()[2];
+                        (
+                            self.plate_centre
+                                + Vector3::new(p.xy[0], p.xy[1], PLATE_TOP + h + 0.0005),
+                            p.yaw,
+                        )
+                    }
+                    None => (
+                        Vector3::new(-0.6, -0.3 + 0.3 * kind.index() as f64, 0.05),
+                        0.0,
+                    ),
+                };
+                let q = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw);
+                qpos[f.qpos..f.qpos + 3].copy_from_slice(pos.as_slice());
+                qpos[f.qpos + 3] = q.w;
+                qpos[f.qpos + 4] = q.i;
+                qpos[f.qpos + 5] = q.j;
+                qpos[f.qpos + 6] = q.k;
+            }
+        }
+        self.props = props;
+        self.target = Some(target);
+        self.set_ctrl(&self.home.clone(), [0.0, 0.0]);
+        self.data.forward();
+        let mut idle = SkewerModel::new(target.index(), self.dt);
+        for _ in 0..150 {
+            self.physics_step(&mut idle)?;
+        }
+        self.timing.total += start.elapsed();
+        Ok(self.true_poses())
+    }
+
+    fn apply_props(&mut self, kind: FoodKind, p: &FoodProps) {
+        let f = self.ids.food[kind.index()];
+        let (size, aabb) = match p.shape {
+            Shape::Disc {
+                radius,
+                half_height,
+            } => ([radius, half_height, 0.0], [radius, radius, half_height]),
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => (
+                [radius, half_length, 0.0],
+                [radius, radius, half_length + radius],
+            ),
+            Shape::Cuboid { half } => (half, half),
+        };
+        // Items weigh grams and their rotational inertia is tiny; a floor
+        // keeps their contacts with the plate numerically stable at 1 ms.
+        let body_frame = p.shape.inertia(p.mass).map(|i| i.max(MIN_INERTIA));
+        // MuJoCo stores inertia in the body's inertial frame (body_iquat),
+        // which the compiler aligned with the geom; it may also place the
+        // geom in that frame, so the frame stays and the diagonal is
+        // expressed in it (the shapes are symmetric: a permutation).
+        let iq = self.data.model().body_iquat()[f.body];
+        let r =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(iq[0], iq[1], iq[2], iq[3]))
+                .to_rotation_matrix();
+        let inertial = r.matrix().transpose()
+            * Matrix3::from_diagonal(&Vector3::from(body_frame))
+            * r.matrix();
+        let inertia = [inertial[(0, 0)], inertial[(1, 1)], inertial[(2, 2)]];
+        // SAFETY: only sizes, masses and inertias of existing elements change;
+        // no count, address or array size of the model is touched.
+        let m = unsafe { self.data.model_mut() };
+        m.geom_size_mut()[f.geom] = size;
+        m.geom_aabb_mut()[f.geom] = [0.0, 0.0, 0.0, aabb[0], aabb[1], aabb[2]];
+        m.geom_rbound_mut()[f.geom] = p.shape.bounding_radius();
+        m.body_mass_mut()[f.body] = p.mass;
+        m.body_inertia_mut()[f.body] = inertia;
+    }
+
+    /// True poses of the items on the plate.
+    pub fn true_poses(&self) -> Vec<TruePose> {
+        FoodKind::ALL
+            .into_iter()
+            .filter_map(|kind| {
+                let p = self.props[kind.index()].as_ref()?;
+                let b = self.ids.food[kind.index()].body;
+                let r = Matrix3::from_row_slice(&self.data.xmat()[b]);
+                Some(TruePose {
+                    kind,
+                    centre: self.data.xpos()[b],
+                    yaw: r[(1, 0)].atan2(r[(0, 0)]),
+                    half_extents: p.shape.half_extents(),
+                })
+            })
+            .collect()
+    }
+
+    fn set_ctrl(&mut self, q: &[f64; 6], fork: [f64; 2]) {
+        let ctrl = self.data.ctrl_mut();
+        ctrl[..6].copy_from_slice(q);
+        ctrl[6] = fork[0];
+        ctrl[7] = fork[1];
+    }
+
+    fn wrist_force(&self) -> Vector3<f64> {
+        let a = self.ids.wrist_force_adr;
+        let s = self.data.sensordata();
+        let f = Vector3::new(s[a], s[a + 1], s[a + 2]);
+        Matrix3::from_row_slice(&self.data.site_xmat()[self.ids.wrist_site]) * f
+    }
+
+    fn physics_step(&mut self, skewer: &mut SkewerModel) -> Result<(), KinovaError> {
+        let d = &self.data;
+        let sx = d.site_xpos();
+        let sm = d.site_xmat();
+        let tines: [TinePose; N_TINES] = std::array::from_fn(|i| {
+            let s = self.ids.tine_sites[i];
+            TinePose {
+                tip: Vector3::from(sx[s]),
+                dir: Vector3::new(sm[s][0], sm[s][3], sm[s][6]),
+            }
+        });
+        let foods: [FoodView<'_>; 3] = std::array::from_fn(|k| {
+            let b = self.ids.food[k].body;
+            FoodView {
+                pos: Vector3::from(d.xpos()[b]),
+                rot: Matrix3::from_row_slice(&d.xmat()[b]),
+                com: Vector3::from(d.xipos()[b]),
+                props: self.props[k].as_ref(),
+            }
+        });
+        let fork_com = Vector3::from(d.xipos()[self.ids.fork_body]);
+        let mut on_food = [Wrench::default(); 3];
+        let on_fork = skewer.step(&tines, fork_com, &foods, &mut on_food);
+        let xfrc = self.data.xfrc_applied_mut();
+        for k in 0..3 {
+            let w = &on_food[k];
+            xfrc[self.ids.food[k].body] = wrench6(w);
+        }
+        xfrc[self.ids.fork_body] = wrench6(&on_fork);
+        let t0 = Instant::now();
+        self.data.step();
+        self.timing.in_step += t0.elapsed();
+        Ok(())
+    }
+
+    /// Executes `action` on the staged target, as perceived.
+    pub fn execute(
+        &mut self,
+        action: &Action,
+        perceived: &PerceivedTarget,
+        mut keyframe: Option<KeyframeHook<'_>>,
+    ) -> Result<AttemptReport, KinovaError> {
+        let start = Instant::now();
+        let Some(target) = self.target.take() else {
+            return Err(KinovaError::MjcfInvalid {
+                origin: "scene".into(),
+                what: "execute called before stage".into(),
+            });
+        };
+        let t_begin = self.data.time();
+        let steps_before = self.step_count();
+        let beta = action.pitch;
+        let fork = [beta, 0.0];
+        let psi = wrap_half_pi(perceived.yaw + action.roll);
+        let base = fork_base_orientation(psi);
+        let u = tine_direction(beta, psi);
+        let c = Vector3::from(perceived.centre);
+        let entry = c + Vector3::new(0.0, 0.0, perceived.half_height);
+        let pre = entry - PRE_OFFSET * u;
+        let q_pre = self
+            .kin
+            .solve(&self.home, fork, &PoseTarget { tip: pre, base }, "pre-pose")?;
+        let mut skewer = SkewerModel::new(target.index(), self.dt);
+        if let Some(k) = keyframe.as_mut() {
+            k("start", &mut self.data);
+        }
+
+        // Pre-pose: joint-space minimum-jerk move; the fork motors turn to β.
+        let home = self.home;
+        let t_move = 0.6;
+        let n = (t_move / self.dt) as usize;
+        for i in 0..n {
+            let w = min_jerk(i as f64 / n as f64);
+            let q: [f64; 6] = std::array::from_fn(|j| home[j] + w * (q_pre[j] - home[j]));
+            self.set_ctrl(&q, fork);
+            self.physics_step(&mut skewer)?;
+        }
+        self.set_ctrl(&q_pre, fork);
+        for _ in 0..(0.15 / self.dt) as usize {
+            self.physics_step(&mut skewer)?;
+        }
+        self.check_finite("pre-pose")?;
+        let reached_pitch = self.data.qpos()[self.ids.fork_qpos[0]];
+        let reached_roll = self.row_angle_to(perceived.yaw);
+        let tare = self.wrist_force();
+        if let Some(k) = keyframe.as_mut() {
+            k("pre_pose", &mut self.data);
+        }
+
+        // Approach and penetrate along the tines.
+        let mut q = q_pre;
+        let mut travel = 0.0;
+        let approach = PRE_OFFSET - 0.005;
+        let mut peak: f64 = 0.0;
+        let stop;
+        let mut step_i = 0u64;
+        loop {
+            let v = if travel < approach { 0.10 } else { 0.03 };
+            travel += v * self.dt;
+            if step_i % 2 == 0 {
+                let target = PoseTarget {
+                    tip: pre + travel * u,
+                    base,
+                };
+                q = self.kin.dls_step(&q, fork, &target, 0.05).0;
+            }
+            step_i += 1;
+            self.set_ctrl(&q, fork);
+            self.physics_step(&mut skewer)?;
+            let f_ax = (self.wrist_force() - tare).dot(&u).abs();
+            if travel > approach {
+                peak = peak.max(f_ax);
+                if f_ax >= action.max_force {
+                    stop = StopReason::Force;
+                    break;
+                }
+            }
+            if travel >= PRE_OFFSET + DEPTH_LIMIT {
+                stop = StopReason::Depth;
+                break;
+            }
+        }
+        self.check_finite("penetration")?;
+        if let Some(k) = keyframe.as_mut() {
+            k("skewer", &mut self.data);
+        }
+
+        // Lift straight up, then hold.
+        let tip0 = pre + travel * u;
+        let mut lift = 0.0;
+        step_i = 0;
+        while lift < LIFT {
+            lift += 0.10 * self.dt;
+            if step_i % 2 == 0 {
+                let target = PoseTarget {
+                    tip: tip0 + Vector3::new(0.0, 0.0, lift),
+                    base,
+                };
+                q = self.kin.dls_step(&q, fork, &target, 0.05).0;
+            }
+            step_i += 1;
+            self.set_ctrl(&q, fork);
+            self.physics_step(&mut skewer)?;
+        }
+        if let Some(k) = keyframe.as_mut() {
+            k("lift", &mut self.data);
+        }
+        for _ in 0..(HOLD / self.dt) as usize {
+            self.physics_step(&mut skewer)?;
+        }
+        self.check_finite("hold")?;
+        if let Some(k) = keyframe.as_mut() {
+            k("hold", &mut self.data);
+        }
+        let b = self.ids.food[target.index()].body;
+        let height = self.data.xpos()[b][2] - self.plate_top_centre().z;
+        let success = height > LIFTED && skewer.pierced_into(target.index()) >= 1;
+        self.timing.total += start.elapsed();
+        self.timing.attempts += 1;
+        Ok(AttemptReport {
+            action: action.name,
+            food: target,
+            success,
+            reached_pitch,
+            reached_roll,
+            stop,
+            peak_force: peak,
+            tines: skewer.stats,
+            final_height: height,
+            sim_time: self.data.time() - t_begin,
+            steps: self.step_count() - steps_before,
+        })
+    }
+
+    fn step_count(&self) -> u64 {
+        (self.data.time() / self.dt).round() as u64
+    }
+
+    /// Angle in [0, π/2] between the tine row (fork y axis, horizontal part)
+    /// and the major axis at `yaw`.
+    fn row_angle_to(&self, yaw: f64) -> f64 {
+        let r = Matrix3::from_row_slice(&self.data.xmat()[self.ids.fork_body]);
+        let y = r.column(1);
+        let row_yaw = y[1].atan2(y[0]);
+        let d = wrap_half_pi(row_yaw - yaw);
+        d.abs()
+    }
+
+    fn check_finite(&self, phase: &'static str) -> Result<(), KinovaError> {
+        if self.data.qpos().iter().all(|v| v.is_finite())
+            && self.data.warning()[MjtWarning::mjWARN_BADQACC as usize].number == 0
+        {
+            Ok(())
+        } else {
+            Err(KinovaError::Diverged {
+                time: self.data.time(),
+                phase,
+            })
+        }
+    }
+}
+
+fn wrench6(w: &Wrench) -> [f64; 6] {
+    [
+        w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z,
+    ]
+}
+
+/// Wraps an angle to (−π/2, π/2]: a tine row is the same line turned by π.
+pub fn wrap_half_pi(a: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let mut x = a.rem_euclid(PI);
+    if x > FRAC_PI_2 {
+        x -= PI;
+    }
+    x
+}

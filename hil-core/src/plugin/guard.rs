@@ -134,37 +134,78 @@ fn cache<O, T>(guard: &Guard, method: &str, inner: O, f: impl FnOnce(&O) -> T) -
     }
 }
 
-/// A plugin [`Policy`] behind a panic guard.
-pub struct GuardedPolicy {
-    inner: Option<Box<dyn Policy>>,
+/// A plugin object of trait `T` behind a panic guard, with the values that
+/// the trait's infallible methods return cached at construction (`F`).
+pub struct Guarded<T: ?Sized, F = ()> {
+    inner: Option<Box<T>>,
     guard: Guard,
     name: String,
-    n_arms: usize,
-    dim: usize,
+    facts: F,
 }
 
-impl std::fmt::Debug for GuardedPolicy {
+/// A plugin [`Policy`] behind a panic guard (caches `n_arms` and `dim`).
+pub type GuardedPolicy = Guarded<dyn Policy, (usize, usize)>;
+/// A plugin [`Environment`] behind a panic guard (caches the action space
+/// and the context dimension).
+pub type GuardedEnvironment = Guarded<dyn Environment, (ActionSpace, usize)>;
+/// A plugin [`WorkloadModel`] behind a panic guard.
+pub type GuardedWorkload = Guarded<dyn WorkloadModel>;
+/// A plugin [`QueryChannel`] behind a panic guard.
+pub type GuardedChannel = Guarded<dyn QueryChannel>;
+
+impl<T: ?Sized, F> std::fmt::Debug for Guarded<T, F> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("GuardedPolicy")
+        f.debug_struct("Guarded")
             .field("name", &self.name)
             .field("guard", &self.guard)
             .finish_non_exhaustive()
     }
 }
 
-impl GuardedPolicy {
-    /// Wraps `inner`, caching its name and shape (a panic there is an error).
-    pub fn new(inner: Box<dyn Policy>, library: PathBuf, type_name: &str) -> Result<Self> {
+impl<T: ?Sized, F> Guarded<T, F> {
+    /// Wraps `inner`, reading its name and facts under the guard (a panic
+    /// there is an error, and the object is dropped under the guard).
+    fn wrap(
+        inner: Box<T>,
+        library: PathBuf,
+        type_name: &str,
+        what: &str,
+        read: impl FnOnce(&T) -> (String, F),
+    ) -> Result<Self> {
         let guard = Guard::new(library, type_name);
-        let (inner, (name, n_arms, dim)) = cache(&guard, "name/n_arms/dim", inner, |p| {
-            (p.name().to_string(), p.n_arms(), p.dim())
-        })?;
+        let (inner, (name, facts)) = cache(&guard, what, inner, |o| read(o))?;
         Ok(Self {
             inner: Some(inner),
             guard,
             name,
-            n_arms,
-            dim,
+            facts,
+        })
+    }
+
+    /// Runs a fallible method of the wrapped object under the guard.
+    fn call<R>(&self, method: &str, f: impl FnOnce(&T) -> Result<R>) -> Result<R> {
+        let o = self.inner.as_deref().ok_or_else(|| self.guard.gone())?;
+        self.guard.run(method, || f(o))
+    }
+
+    /// Runs a fallible `&mut self` method of the wrapped object under the guard.
+    fn call_mut<R>(&mut self, method: &str, f: impl FnOnce(&mut T) -> Result<R>) -> Result<R> {
+        let o = self.inner.as_deref_mut().ok_or_else(|| self.guard.gone())?;
+        self.guard.run(method, || f(o))
+    }
+}
+
+impl<T: ?Sized, F> Drop for Guarded<T, F> {
+    fn drop(&mut self) {
+        drop_guarded(self.inner.take());
+    }
+}
+
+impl GuardedPolicy {
+    /// Wraps `inner`, caching its name and shape (a panic there is an error).
+    pub fn new(inner: Box<dyn Policy>, library: PathBuf, type_name: &str) -> Result<Self> {
+        Self::wrap(inner, library, type_name, "name/n_arms/dim", |p| {
+            (p.name().to_string(), (p.n_arms(), p.dim()))
         })
     }
 }
@@ -174,10 +215,10 @@ impl Policy for GuardedPolicy {
         &self.name
     }
     fn n_arms(&self) -> usize {
-        self.n_arms
+        self.facts.0
     }
     fn dim(&self) -> usize {
-        self.dim
+        self.facts.1
     }
     fn seed(&mut self, seed: u64) {
         if let Some(p) = self.inner.as_mut() {
@@ -185,66 +226,34 @@ impl Policy for GuardedPolicy {
         }
     }
     fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
-        let p = self.inner.as_mut().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("decide", || p.decide(input))
+        self.call_mut("decide", |p| p.decide(input))
     }
     fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()> {
-        let p = self.inner.as_mut().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("observe", || p.observe(feedback))
+        self.call_mut("observe", |p| p.observe(feedback))
     }
     fn save(&self) -> Result<Value> {
-        let p = self.inner.as_ref().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("save", || p.save())
+        self.call("save", |p| p.save())
     }
     fn restore(&mut self, state: Value) -> Result<()> {
-        let p = self.inner.as_mut().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("restore", || p.restore(state))
-    }
-}
-
-impl Drop for GuardedPolicy {
-    fn drop(&mut self) {
-        drop_guarded(self.inner.take());
-    }
-}
-
-/// A plugin [`Environment`] behind a panic guard.
-pub struct GuardedEnvironment {
-    inner: Option<Box<dyn Environment>>,
-    guard: Guard,
-    name: String,
-    actions: ActionSpace,
-    dim: usize,
-}
-
-impl std::fmt::Debug for GuardedEnvironment {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("GuardedEnvironment")
-            .field("name", &self.name)
-            .field("guard", &self.guard)
-            .finish_non_exhaustive()
+        self.call_mut("restore", |p| p.restore(state))
     }
 }
 
 impl GuardedEnvironment {
     /// Wraps `inner`, caching its name, action space and context dimension.
     pub fn new(inner: Box<dyn Environment>, library: PathBuf, type_name: &str) -> Result<Self> {
-        let guard = Guard::new(library, type_name);
-        let (inner, (name, actions, dim)) =
-            cache(&guard, "name/action_space/context_dim", inner, |e| {
+        Self::wrap(
+            inner,
+            library,
+            type_name,
+            "name/action_space/context_dim",
+            |e| {
                 (
                     e.name().to_string(),
-                    e.action_space().clone(),
-                    e.context_dim(),
+                    (e.action_space().clone(), e.context_dim()),
                 )
-            })?;
-        Ok(Self {
-            inner: Some(inner),
-            guard,
-            name,
-            actions,
-            dim,
-        })
+            },
+        )
     }
 }
 
@@ -253,26 +262,22 @@ impl Environment for GuardedEnvironment {
         &self.name
     }
     fn action_space(&self) -> &ActionSpace {
-        &self.actions
+        &self.facts.0
     }
     fn context_dim(&self) -> usize {
-        self.dim
+        self.facts.1
     }
     fn reset(&mut self, seed: u64) -> Result<()> {
-        let e = self.inner.as_mut().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("reset", || e.reset(seed))
+        self.call_mut("reset", |e| e.reset(seed))
     }
     fn next_item(&mut self) -> Result<Option<Item>> {
-        let e = self.inner.as_mut().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("next_item", || e.next_item())
+        self.call_mut("next_item", |e| e.next_item())
     }
     fn observe(&mut self) -> Result<Context> {
-        let e = self.inner.as_mut().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("observe", || e.observe())
+        self.call_mut("observe", |e| e.observe())
     }
     fn execute(&mut self, arm: ArmId) -> Result<Outcome> {
-        let e = self.inner.as_mut().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("execute", || e.execute(arm))
+        self.call_mut("execute", |e| e.execute(arm))
     }
     fn best_action(&self) -> Option<ArmId> {
         let e = self.inner.as_ref()?;
@@ -284,37 +289,11 @@ impl Environment for GuardedEnvironment {
     }
 }
 
-impl Drop for GuardedEnvironment {
-    fn drop(&mut self) {
-        drop_guarded(self.inner.take());
-    }
-}
-
-/// A plugin [`WorkloadModel`] behind a panic guard.
-pub struct GuardedWorkload {
-    inner: Option<Box<dyn WorkloadModel>>,
-    guard: Guard,
-    name: String,
-}
-
-impl std::fmt::Debug for GuardedWorkload {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("GuardedWorkload")
-            .field("name", &self.name)
-            .field("guard", &self.guard)
-            .finish_non_exhaustive()
-    }
-}
-
 impl GuardedWorkload {
     /// Wraps `inner`, caching its name.
     pub fn new(inner: Box<dyn WorkloadModel>, library: PathBuf, type_name: &str) -> Result<Self> {
-        let guard = Guard::new(library, type_name);
-        let (inner, name) = cache(&guard, "name", inner, |o| o.name().to_string())?;
-        Ok(Self {
-            inner: Some(inner),
-            guard,
-            name,
+        Self::wrap(inner, library, type_name, "name", |m| {
+            (m.name().to_string(), ())
         })
     }
 }
@@ -324,8 +303,7 @@ impl WorkloadModel for GuardedWorkload {
         &self.name
     }
     fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        let m = self.inner.as_ref().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("predict", || m.predict(wl0, history, t))
+        self.call("predict", |m| m.predict(wl0, history, t))
     }
     fn predict_if_queried(
         &self,
@@ -334,44 +312,17 @@ impl WorkloadModel for GuardedWorkload {
         t: Timestep,
         kind: QueryKind,
     ) -> Result<f64> {
-        let m = self.inner.as_ref().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("predict_if_queried", || {
+        self.call("predict_if_queried", |m| {
             m.predict_if_queried(wl0, history, t, kind)
         })
-    }
-}
-
-impl Drop for GuardedWorkload {
-    fn drop(&mut self) {
-        drop_guarded(self.inner.take());
-    }
-}
-
-/// A plugin [`QueryChannel`] behind a panic guard.
-pub struct GuardedChannel {
-    inner: Option<Box<dyn QueryChannel>>,
-    guard: Guard,
-    name: String,
-}
-
-impl std::fmt::Debug for GuardedChannel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("GuardedChannel")
-            .field("name", &self.name)
-            .field("guard", &self.guard)
-            .finish_non_exhaustive()
     }
 }
 
 impl GuardedChannel {
     /// Wraps `inner`, caching its name.
     pub fn new(inner: Box<dyn QueryChannel>, library: PathBuf, type_name: &str) -> Result<Self> {
-        let guard = Guard::new(library, type_name);
-        let (inner, name) = cache(&guard, "name", inner, |o| o.name().to_string())?;
-        Ok(Self {
-            inner: Some(inner),
-            guard,
-            name,
+        Self::wrap(inner, library, type_name, "name", |c| {
+            (c.name().to_string(), ())
         })
     }
 }
@@ -386,13 +337,6 @@ impl QueryChannel for GuardedChannel {
         }
     }
     fn ask(&mut self, query: &Query) -> Result<Response> {
-        let c = self.inner.as_mut().ok_or_else(|| self.guard.gone())?;
-        self.guard.run("ask", || c.ask(query))
-    }
-}
-
-impl Drop for GuardedChannel {
-    fn drop(&mut self) {
-        drop_guarded(self.inner.take());
+        self.call_mut("ask", |c| c.ask(query))
     }
 }

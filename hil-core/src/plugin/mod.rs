@@ -66,7 +66,7 @@ pub use abi::{
 };
 pub use config::PluginComponent;
 pub(crate) use config::{component, optional_component};
-pub use guard::{GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload};
+pub use guard::{Guarded, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload};
 pub use registrar::{
     ComponentKind, EnvironmentFactory, Factory, ParamFormat, Params, PluginRegistrar,
     PolicyFactory, QueryChannelFactory, Registrar, WorkloadModelFactory,

@@ -18,7 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 xy: [0.0, 0.0],
                 yaw: 0.3,
             }];
-            let poses = sim.stage(&items, kind)?;
+            let poses = sim.stage(&items, None, kind)?;
             let t = poses[0];
             let perceived = PerceivedTarget {
                 centre: t.centre,

@@ -1,25 +1,86 @@
 //! Success rates per (food, action) over randomised trials, beside the
-//! published rates (Feng et al. 2019, setting `all`).
+//! published rates (Feng et al. 2019), overall and per placement setting.
+//!
+//! Trials cycle through the settings (trial `t` uses `settings[t % n]`), so
+//! 30 trials over the three settings are 10 per setting, as in the
+//! published data set, and the overall rate compares with its `all` row.
+//! Attempts run on `threads` worker threads, each with its own simulator;
+//! every attempt's seed depends only on (seed, food, action, trial), so the
+//! result does not depend on the number of threads.
 //!
 //! ```
-//! use hil_kinova_mujoco::calibrate::calibrate_foods;
-//! use hil_kinova_mujoco::FoodKind;
+//! use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
+//! use hil_kinova_mujoco::{FoodKind, Setting};
 //!
-//! // `calibrate(30, 1)` runs every food; one trial on carrot here.
-//! let report = calibrate_foods(&[FoodKind::Carrot], 1, 1, &mut |_, _| {})?;
+//! let opts = CalibrationOptions {
+//!     foods: vec![FoodKind::Carrot],
+//!     settings: vec![Setting::Isolated],
+//!     trials: 1,
+//!     ..CalibrationOptions::default()
+//! };
+//! let report = calibrate_with(&opts, &|_, _| {}, &mut |_| {})?;
 //! assert_eq!(report.rows.len(), 6);
-//! assert_eq!(report.rows[1].published, Some(0.53)); // VS90
+//! // VS90 on carrot: published 1.0 when isolated (0.53 over all settings).
+//! assert_eq!(report.rows[1].by_setting[0].published, Some(1.0));
+//! assert_eq!(report.rows[1].published, Some(1.0));
+//! assert_eq!(report.rows[1].trials, 1);
 //! # Ok::<(), hil_core::HilError>(())
 //! ```
 
-use std::time::Instant;
+use std::collections::HashMap;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
-use hil_core::{ArmId, Environment, Result};
+use hil_core::{ArmId, Environment, HilError, Result};
 use serde::Serialize;
 
 use crate::controller::ACTIONS;
 use crate::env::{KinovaFeedingConfig, KinovaFeedingEnv};
-use crate::food::FoodKind;
+use crate::food::{FoodKind, Setting};
+use crate::sim::AttemptReport;
+
+/// What to calibrate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CalibrationOptions {
+    /// Foods to run.
+    pub foods: Vec<FoodKind>,
+    /// Settings the trials cycle through.
+    pub settings: Vec<Setting>,
+    /// Trials per (food, action).
+    pub trials: usize,
+    /// Master seed.
+    pub seed: u64,
+    /// Worker threads (each with its own simulator).
+    pub threads: usize,
+}
+
+impl Default for CalibrationOptions {
+    fn default() -> Self {
+        Self {
+            foods: FoodKind::ALL.to_vec(),
+            settings: Setting::ALL.to_vec(),
+            trials: 30,
+            seed: 1,
+            threads: 1,
+        }
+    }
+}
+
+/// One (food, action) cell in one setting.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SettingCell {
+    /// The setting.
+    pub setting: Setting,
+    /// Trials run.
+    pub trials: usize,
+    /// Successes.
+    pub successes: usize,
+    /// Achieved success rate.
+    pub rate: f64,
+    /// Published rate in this setting.
+    pub published: Option<f64>,
+}
 
 /// One (food, action) cell.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -34,8 +95,27 @@ pub struct CalibrationRow {
     pub successes: usize,
     /// Achieved success rate.
     pub rate: f64,
-    /// Published rate, where one exists.
+    /// Published rate (setting `all`) when the trials cover all three
+    /// settings equally; otherwise the mean of the published rates of the
+    /// settings run.
     pub published: Option<f64>,
+    /// The same cell per setting.
+    pub by_setting: Vec<SettingCell>,
+}
+
+/// One simulated attempt, for the attempt log.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AttemptRecord {
+    /// Food.
+    pub food: FoodKind,
+    /// Setting.
+    pub setting: Setting,
+    /// Trial index within the (food, action) cell.
+    pub trial: usize,
+    /// Seed the environment was reset with.
+    pub seed: u64,
+    /// What the simulation measured.
+    pub report: AttemptReport,
 }
 
 /// The calibration table and throughput.
@@ -43,78 +123,229 @@ pub struct CalibrationRow {
 pub struct CalibrationReport {
     /// One row per (food, action).
     pub rows: Vec<CalibrationRow>,
-    /// Mean absolute difference to the published rates.
+    /// Mean absolute difference to the published rates (overall rows).
     pub mean_abs_error: f64,
-    /// Simulated attempts per wall-clock second (one core).
+    /// Mean absolute difference per setting cell.
+    pub mean_abs_error_by_setting: f64,
+    /// Simulated attempts per wall-clock second, all threads together.
     pub attempts_per_second: f64,
-    /// Share of wall-clock time spent outside `mj_step`.
+    /// Simulated attempts per second of one thread's busy time (one core).
+    pub attempts_per_second_per_core: f64,
+    /// Worker threads used.
+    pub threads: usize,
+    /// Share of the attempts' time spent outside `mj_step`.
     pub overhead_share: f64,
     /// Provenance note.
     pub note: &'static str,
 }
 
-/// Runs `trials` randomised attempts of every action on every food.
+/// Runs `trials` randomised attempts of every action on every food over all
+/// three settings, on one thread.
 pub fn calibrate(trials: usize, seed: u64) -> Result<CalibrationReport> {
-    calibrate_foods(&FoodKind::ALL, trials, seed, &mut |_, _| {})
+    calibrate_with(
+        &CalibrationOptions {
+            trials,
+            seed,
+            ..CalibrationOptions::default()
+        },
+        &|_, _| {},
+        &mut |_| {},
+    )
 }
 
-/// Like [`calibrate`] for some foods, reporting progress `(done, total)`.
-pub fn calibrate_foods(
-    foods: &[FoodKind],
-    trials: usize,
-    seed: u64,
-    progress: &mut dyn FnMut(usize, usize),
+/// The seed of trial `trial` of `action` on `food`.
+pub fn trial_seed(seed: u64, food: FoodKind, action: usize, trial: usize) -> u64 {
+    seed.wrapping_mul(1_000_003)
+        .wrapping_add((food.index() * 6 + action) as u64 * 10_007 + trial as u64)
+}
+
+/// Runs the calibration described by `opts`, reporting progress
+/// `(done, total)` from the worker threads and every attempt, in job order,
+/// to `log`.
+pub fn calibrate_with(
+    opts: &CalibrationOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    log: &mut dyn FnMut(&AttemptRecord),
 ) -> Result<CalibrationReport> {
+    if opts.foods.is_empty() || opts.settings.is_empty() || opts.trials == 0 || opts.threads == 0 {
+        return Err(HilError::invalid_parameter(
+            "calibration",
+            format!(
+                "{} foods, {} settings, {} trials, {} threads",
+                opts.foods.len(),
+                opts.settings.len(),
+                opts.trials,
+                opts.threads
+            ),
+            "needs at least one of each",
+        ));
+    }
     let start = Instant::now();
-    let mut rows = Vec::new();
-    let total = foods.len() * ACTIONS.len() * trials;
-    let mut done = 0;
-    let mut in_step = std::time::Duration::ZERO;
-    let mut sim_total = std::time::Duration::ZERO;
-    for &food in foods {
-        let cfg = KinovaFeedingConfig {
-            plate: vec![food.name().to_string(); 1],
-            ..KinovaFeedingConfig::default()
-        };
-        let mut env = KinovaFeedingEnv::new(cfg)?;
-        for (a, action) in ACTIONS.iter().enumerate() {
-            let mut successes = 0;
-            for t in 0..trials {
-                env.reset(
-                    seed.wrapping_mul(1_000_003)
-                        .wrapping_add((food.index() * 6 + a) as u64 * 10_007 + t as u64),
-                )?;
+    let jobs: Vec<(FoodKind, usize, usize)> = opts
+        .foods
+        .iter()
+        .flat_map(|&f| {
+            (0..ACTIONS.len()).flat_map(move |a| (0..opts.trials).map(move |t| (f, a, t)))
+        })
+        .collect();
+    let total = jobs.len();
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<AttemptRecord>>> = Mutex::new(vec![None; total]);
+    let timing = Mutex::new((Duration::ZERO, Duration::ZERO));
+    let worker = || -> Result<()> {
+        let mut envs: HashMap<(FoodKind, Setting), KinovaFeedingEnv> = HashMap::new();
+        let out = (|| -> Result<()> {
+            loop {
+                let j = next.fetch_add(1, Ordering::Relaxed);
+                let Some(&(food, a, t)) = jobs.get(j) else {
+                    return Ok(());
+                };
+                let setting = opts.settings[t % opts.settings.len()];
+                let env = match envs.entry((food, setting)) {
+                    std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                    std::collections::hash_map::Entry::Vacant(e) => {
+                        e.insert(KinovaFeedingEnv::new(KinovaFeedingConfig {
+                            plate: vec![food.name().to_string()],
+                            settings: vec![setting.name().to_string()],
+                            ..KinovaFeedingConfig::default()
+                        })?)
+                    }
+                };
+                let seed = trial_seed(opts.seed, food, a, t);
+                env.reset(seed)?;
                 env.next_item()?;
                 env.observe()?;
-                if env.execute(ArmId(a))?.success {
-                    successes += 1;
-                }
-                done += 1;
-                progress(done, total);
+                env.execute(ArmId(a))?;
+                let report = env.last_attempt().cloned().ok_or_else(|| {
+                    HilError::state("kinova calibrate", "an attempt left no report")
+                })?;
+                lock(&results)[j] = Some(AttemptRecord {
+                    food,
+                    setting,
+                    trial: t,
+                    seed,
+                    report,
+                });
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             }
+        })();
+        let mut tm = lock(&timing);
+        for env in envs.values() {
+            let t = env.simulator().timing();
+            tm.0 += t.in_step;
+            tm.1 += t.total;
+        }
+        if out.is_err() {
+            // Stop the other workers early.
+            next.store(total, Ordering::Relaxed);
+        }
+        out
+    };
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..opts.threads).map(|_| s.spawn(worker)).collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join().unwrap_or_else(|_| {
+                    Err(HilError::state("kinova calibrate", "a worker panicked"))
+                })
+            })
+            .collect::<Result<Vec<()>>>()
+    })?;
+    let wall = start.elapsed().as_secs_f64();
+    let records: Vec<AttemptRecord> = results
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner())
+        .into_iter()
+        .collect::<Option<_>>()
+        .ok_or_else(|| HilError::state("kinova calibrate", "an attempt did not run"))?;
+    for r in &records {
+        log(r);
+    }
+    let rows = tabulate(opts, &records);
+    let (in_step, busy) = timing.into_inner().unwrap_or_else(|e| e.into_inner());
+    let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    Ok(CalibrationReport {
+        mean_abs_error: mean(
+            rows.iter()
+                .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
+                .collect(),
+        ),
+        mean_abs_error_by_setting: mean(
+            rows.iter()
+                .flat_map(|r| &r.by_setting)
+                .filter_map(|c| c.published.map(|p| (p - c.rate).abs()))
+                .collect(),
+        ),
+        attempts_per_second: total as f64 / wall.max(1e-9),
+        attempts_per_second_per_core: total as f64 / busy.as_secs_f64().max(1e-9),
+        threads: opts.threads,
+        overhead_share: 1.0 - in_step.as_secs_f64() / busy.as_secs_f64().max(1e-9),
+        rows,
+        note: "simulated (MuJoCo) attempts with synthetic food properties; published rates: Feng et al. 2019 (settings isolated, wall, lettuce; `all` is their mean)",
+    })
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Groups attempt records into rows per (food, action), in job order.
+fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<CalibrationRow> {
+    let mut rows = Vec::new();
+    for &food in &opts.foods {
+        for (a, action) in ACTIONS.iter().enumerate() {
+            let cell: Vec<&AttemptRecord> = records
+                .iter()
+                .filter(|r| r.food == food && r.report.action == action.name)
+                .collect();
+            let by_setting: Vec<SettingCell> = opts
+                .settings
+                .iter()
+                .map(|&setting| {
+                    let trials = cell.iter().filter(|r| r.setting == setting).count();
+                    let successes = cell
+                        .iter()
+                        .filter(|r| r.setting == setting && r.report.success)
+                        .count();
+                    SettingCell {
+                        setting,
+                        trials,
+                        successes,
+                        rate: successes as f64 / trials.max(1) as f64,
+                        published: Some(food.published_rates_in(setting)[a]),
+                    }
+                })
+                .collect();
+            let trials = cell.len();
+            let successes = cell.iter().filter(|r| r.report.success).count();
+            // With all three settings equally represented the published
+            // `all` row applies; otherwise the trial-weighted mean of the
+            // settings run.
+            let covers_all = Setting::ALL.iter().all(|s| opts.settings.contains(s))
+                && by_setting.iter().all(|c| c.trials == by_setting[0].trials);
+            let published = if covers_all {
+                Some(food.published_rates()[a])
+            } else {
+                Some(
+                    by_setting
+                        .iter()
+                        .map(|c| food.published_rates_in(c.setting)[a] * c.trials as f64)
+                        .sum::<f64>()
+                        / trials.max(1) as f64,
+                )
+            };
             rows.push(CalibrationRow {
                 food: food.name().into(),
                 action: action.name.into(),
                 trials,
                 successes,
                 rate: successes as f64 / trials.max(1) as f64,
-                published: Some(food.published_rates()[a]),
+                published,
+                by_setting,
             });
         }
-        let t = env.simulator().timing();
-        in_step += t.in_step;
-        sim_total += t.total;
     }
-    let errs: Vec<f64> = rows
-        .iter()
-        .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
-        .collect();
-    let wall = start.elapsed().as_secs_f64();
-    Ok(CalibrationReport {
-        mean_abs_error: errs.iter().sum::<f64>() / errs.len().max(1) as f64,
-        attempts_per_second: total as f64 / wall.max(1e-9),
-        overhead_share: 1.0 - in_step.as_secs_f64() / sim_total.as_secs_f64().max(1e-9),
-        rows,
-        note: "simulated (MuJoCo) attempts with synthetic food properties; published rates: Feng et al. 2019, setting `all`",
-    })
+    rows
 }

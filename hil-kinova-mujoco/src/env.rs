@@ -27,10 +27,10 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::controller::ACTIONS;
-use crate::food::{FoodKind, FoodModel, FoodProps};
+use crate::food::{FoodKind, FoodModel, FoodProps, Setting};
 use crate::model::MjcfSource;
-use crate::perception::{Embedding, Observation, PerceptionNoise, perceive};
-use crate::sim::{AttemptReport, KeyframeHook, Placement, Simulator};
+use crate::perception::{Embedding, Observation, PerceptionNoise, RIM_RADIUS, perceive};
+use crate::sim::{AttemptReport, KeyframeHook, LeafPlacement, Placement, Simulator};
 
 /// Configuration of [`KinovaFeedingEnv`] (`type = "kinova_feeding"`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -45,6 +45,10 @@ pub struct KinovaFeedingConfig {
     /// Seed of the fixed feature embedding.
     #[serde(default)]
     pub embedding_seed: u64,
+    /// Settings an item may be placed in (`isolated`, `wall`, `lettuce`);
+    /// each item draws one uniformly.
+    #[serde(default = "default_settings")]
+    pub settings: Vec<String>,
     /// Place the episode's other remaining items on the plate too.
     #[serde(default = "yes")]
     pub neighbours: bool,
@@ -65,6 +69,9 @@ pub struct KinovaFeedingConfig {
 fn default_plate() -> Vec<String> {
     FoodKind::ALL.iter().map(|k| k.name().to_string()).collect()
 }
+fn default_settings() -> Vec<String> {
+    Setting::ALL.iter().map(|k| k.name().to_string()).collect()
+}
 fn default_dim() -> usize {
     32
 }
@@ -78,6 +85,7 @@ impl Default for KinovaFeedingConfig {
             plate: default_plate(),
             context_dim: default_dim(),
             embedding_seed: 0,
+            settings: default_settings(),
             neighbours: true,
             mjcf: None,
             noise: PerceptionNoise::default(),
@@ -109,8 +117,31 @@ impl KinovaFeedingConfig {
             .collect()
     }
 
+    fn parsed_settings(&self) -> Result<Vec<Setting>> {
+        if self.settings.is_empty() {
+            return Err(HilError::invalid_parameter(
+                "settings",
+                "[]",
+                "needs at least one of isolated, wall, lettuce",
+            ));
+        }
+        self.settings
+            .iter()
+            .map(|s| {
+                Setting::parse(s).ok_or_else(|| {
+                    HilError::invalid_parameter(
+                        "settings",
+                        format!("{s:?}"),
+                        "unknown setting; expected isolated, wall or lettuce",
+                    )
+                })
+            })
+            .collect()
+    }
+
     fn validate(&self) -> Result<()> {
         self.foods()?;
+        self.parsed_settings()?;
         if self.context_dim == 0 || self.context_dim > 4096 {
             return Err(HilError::invalid_parameter(
                 "context_dim",
@@ -200,6 +231,7 @@ pub fn simulated_pretraining(
 struct Current {
     item: Item,
     props: FoodProps,
+    setting: Setting,
     observation: Option<Observation>,
 }
 
@@ -214,6 +246,7 @@ struct Current {
 pub struct KinovaFeedingEnv {
     cfg: KinovaFeedingConfig,
     foods: Vec<FoodKind>,
+    settings: Vec<Setting>,
     models: Vec<FoodModel>,
     sim: Simulator,
     embedding: Embedding,
@@ -234,6 +267,7 @@ impl KinovaFeedingEnv {
         };
         Ok(Self {
             foods: cfg.foods()?,
+            settings: cfg.parsed_settings()?,
             models: FoodKind::ALL
                 .iter()
                 .map(|&k| FoodModel::default_for(k))
@@ -252,6 +286,11 @@ impl KinovaFeedingEnv {
     /// The simulator (for rendering and timing).
     pub fn simulator(&self) -> &Simulator {
         &self.sim
+    }
+
+    /// The setting of the current item.
+    pub fn current_setting(&self) -> Option<Setting> {
+        self.current.as_ref().map(|c| c.setting)
     }
 
     /// Details of the last executed attempt.
@@ -282,39 +321,103 @@ impl KinovaFeedingEnv {
         })
     }
 
-    fn place(&mut self, target: &FoodProps) -> Vec<Placement> {
-        let mut items = vec![target.clone()];
+    /// Lays out the plate for `target` in `setting`: the target first,
+    /// then (with `neighbours`) the episode's remaining items where they fit
+    /// clear of it, of the leaf and of the rim; a neighbour with no free
+    /// spot after 200 draws is left off the plate.
+    fn place(
+        &mut self,
+        target: &FoodProps,
+        setting: Setting,
+    ) -> (Vec<Placement>, Option<LeafPlacement>) {
+        use std::f64::consts::{PI, TAU};
+        let rng = &mut self.rng;
+        let mut leaf = None;
+        let reach = target.shape.half_extents()[0];
+        let angle = rng.random_range(0.0..TAU);
+        let first = match setting {
+            Setting::Isolated => {
+                let rad =
+                    (RIM_RADIUS - reach - ISOLATED_CLEARANCE).max(0.0) * rng.random::<f64>().sqrt();
+                let yaw = rng.random_range(-PI..PI);
+                Placement {
+                    props: target.clone(),
+                    xy: [rad * angle.cos(), rad * angle.sin()],
+                    yaw,
+                }
+            }
+            Setting::Wall => {
+                let [hx, hy, _] = target.shape.half_extents();
+                // An elongated item lies along the rim; others at any yaw.
+                let yaw = if hx > 1.3 * hy {
+                    angle + PI / 2.0 + 0.15 * rng.random_range(-1.0..1.0)
+                } else {
+                    rng.random_range(-PI..PI)
+                };
+                let d = yaw - angle;
+                let radial = match target.shape {
+                    crate::food::Shape::Disc { radius, .. } => radius,
+                    _ => hx * d.cos().abs() + hy * d.sin().abs(),
+                };
+                let rad = RIM_RADIUS - radial - 0.001;
+                Placement {
+                    props: target.clone(),
+                    xy: [rad * angle.cos(), rad * angle.sin()],
+                    yaw,
+                }
+            }
+            Setting::Lettuce => {
+                let rad = (RIM_RADIUS - LEAF_REACH - 0.004) * rng.random::<f64>().sqrt();
+                let xy = [rad * angle.cos(), rad * angle.sin()];
+                leaf = Some(LeafPlacement {
+                    xy,
+                    yaw: rng.random_range(-PI..PI),
+                    under: target.kind,
+                });
+                Placement {
+                    props: target.clone(),
+                    xy,
+                    yaw: rng.random_range(-PI..PI),
+                }
+            }
+        };
+        // Keep-out discs: (centre, radius).
+        let mut taken = vec![(first.xy, if leaf.is_some() { LEAF_REACH } else { reach })];
+        let mut placed = vec![first];
         if self.cfg.neighbours {
             for &k in &self.foods[self.cursor..] {
-                if items.iter().all(|p| p.kind != k) {
-                    items.push(self.models[k.index()].sample(&mut self.rng));
+                if placed.iter().any(|p| p.props.kind == k) {
+                    continue;
+                }
+                let props = self.models[k.index()].sample(rng);
+                let r = props.shape.half_extents()[0];
+                for _ in 0..200 {
+                    let rad = (RIM_RADIUS - r - 0.003).max(0.0) * rng.random::<f64>().sqrt();
+                    let a = rng.random_range(0.0..TAU);
+                    let xy = [rad * a.cos(), rad * a.sin()];
+                    let clear = taken.iter().all(|(c, cr)| {
+                        ((c[0] - xy[0]).powi(2) + (c[1] - xy[1]).powi(2)).sqrt() > r + cr + 0.006
+                    });
+                    if clear {
+                        taken.push((xy, r));
+                        placed.push(Placement {
+                            props,
+                            xy,
+                            yaw: rng.random_range(-PI..PI),
+                        });
+                        break;
+                    }
                 }
             }
         }
-        let mut placed: Vec<Placement> = Vec::new();
-        for props in items {
-            let r = props.shape.half_extents()[0];
-            let mut xy = [0.0, 0.0];
-            for _ in 0..200 {
-                let rad = (0.085 - r).max(0.0) * self.rng.random::<f64>().sqrt();
-                let a = self.rng.random_range(0.0..std::f64::consts::TAU);
-                xy = [rad * a.cos(), rad * a.sin()];
-                let clear = placed.iter().all(|p| {
-                    let d = ((p.xy[0] - xy[0]).powi(2) + (p.xy[1] - xy[1]).powi(2)).sqrt();
-                    d > r + p.props.shape.half_extents()[0] + 0.006
-                });
-                if clear {
-                    break;
-                }
-            }
-            let yaw = self
-                .rng
-                .random_range(-std::f64::consts::PI..std::f64::consts::PI);
-            placed.push(Placement { props, xy, yaw });
-        }
-        placed
+        (placed, leaf)
     }
 }
+
+/// An isolated item keeps at least this far from the rim (m).
+const ISOLATED_CLEARANCE: f64 = 0.02;
+/// Radius of the disc the lettuce leaf covers, whatever its yaw (m).
+const LEAF_REACH: f64 = 0.044;
 
 impl Environment for KinovaFeedingEnv {
     fn name(&self) -> &str {
@@ -343,23 +446,30 @@ impl Environment for KinovaFeedingEnv {
             return Ok(None);
         };
         let props = self.models[kind.index()].sample(&mut self.rng);
+        let setting = self.settings[self.rng.random_range(0..self.settings.len())];
+        let where_ = match setting {
+            Setting::Isolated => "alone on the plate",
+            Setting::Wall => "against the plate's rim",
+            Setting::Lettuce => "on a lettuce leaf",
+        };
         let item = Item {
             index: self.cursor,
             label: kind.name().to_string(),
-            description: Some(format!("a {} on the plate", kind.name())),
+            description: Some(format!("a {} {where_}", kind.name())),
         };
         self.cursor += 1;
         self.current = Some(Current {
             item: item.clone(),
             props,
+            setting,
             observation: None,
         });
         Ok(Some(item))
     }
 
     fn observe(&mut self) -> Result<Context> {
-        let props = match &self.current {
-            Some(c) => c.props.clone(),
+        let (props, setting) = match &self.current {
+            Some(c) => (c.props.clone(), c.setting),
             None => {
                 return Err(HilError::state(
                     "kinova_feeding",
@@ -369,9 +479,9 @@ impl Environment for KinovaFeedingEnv {
         };
         // Items already eaten are gone; the current one is `cursor - 1`.
         self.cursor -= 1;
-        let placed = self.place(&props);
+        let (placed, leaf) = self.place(&props, setting);
         self.cursor += 1;
-        let poses = self.sim.stage(&placed, props.kind)?;
+        let poses = self.sim.stage(&placed, leaf, props.kind)?;
         let target = poses
             .iter()
             .position(|p| p.kind == props.kind)
@@ -382,7 +492,7 @@ impl Environment for KinovaFeedingEnv {
             target,
             &props.shape,
             props.colour,
-            [plate.x, plate.y],
+            [plate.x, plate.y, plate.z],
             &self.cfg.noise,
             &mut self.rng,
         );

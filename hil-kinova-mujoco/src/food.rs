@@ -59,13 +59,30 @@ impl FoodKind {
         format!("food_{}_geom", self.name())
     }
 
-    /// Published success rates (Feng et al. 2019, setting `all`) in the
-    /// order VS0 VS90 TV0 TV90 TA0 TA90.
+    /// Published success rates (Feng et al. 2019, setting `all`: the mean
+    /// of the three settings) in the order VS0 VS90 TV0 TV90 TA0 TA90.
     pub fn published_rates(self) -> [f64; 6] {
         match self {
             FoodKind::Banana => [0.2, 0.2, 0.1, 0.1, 0.57, 0.57],
             FoodKind::Carrot => [0.0, 0.53, 0.0, 0.43, 0.0, 0.03],
             FoodKind::Cantaloupe => [0.77, 0.93, 0.7, 0.8, 0.3, 0.27],
+        }
+    }
+
+    /// Published success rates in one placement setting (10 trials per
+    /// cell in the source), same order as [`published_rates`](Self::published_rates).
+    pub fn published_rates_in(self, setting: Setting) -> [f64; 6] {
+        use Setting::*;
+        match (self, setting) {
+            (FoodKind::Banana, Isolated) => [0.0, 0.0, 0.0, 0.0, 0.2, 0.2],
+            (FoodKind::Banana, Wall) => [0.0, 0.0, 0.0, 0.0, 0.9, 0.9],
+            (FoodKind::Banana, Lettuce) => [0.6, 0.6, 0.3, 0.3, 0.6, 0.6],
+            (FoodKind::Carrot, Isolated) => [0.0, 1.0, 0.0, 0.8, 0.0, 0.0],
+            (FoodKind::Carrot, Wall) => [0.0, 0.4, 0.0, 0.3, 0.0, 0.1],
+            (FoodKind::Carrot, Lettuce) => [0.0, 0.2, 0.0, 0.2, 0.0, 0.0],
+            (FoodKind::Cantaloupe, Isolated) => [0.9, 1.0, 1.0, 0.7, 0.0, 0.0],
+            (FoodKind::Cantaloupe, Wall) => [0.8, 0.9, 0.7, 0.9, 0.4, 0.6],
+            (FoodKind::Cantaloupe, Lettuce) => [0.6, 0.9, 0.4, 0.8, 0.5, 0.2],
         }
     }
 
@@ -83,6 +100,38 @@ impl FoodKind {
             FoodKind::Carrot => [0.95, 0.50, 0.12],
             FoodKind::Cantaloupe => [0.98, 0.66, 0.38],
         }
+    }
+}
+
+/// Where an item lies, as in the published data set's three settings: alone
+/// on the plate, against the plate's rim, or on a lettuce leaf.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
+#[serde(rename_all = "snake_case")]
+pub enum Setting {
+    /// Clear of the rim and of other items.
+    Isolated,
+    /// Touching the plate's rim.
+    Wall,
+    /// Resting on a lettuce leaf.
+    Lettuce,
+}
+
+impl Setting {
+    /// Every setting.
+    pub const ALL: [Setting; 3] = [Setting::Isolated, Setting::Wall, Setting::Lettuce];
+
+    /// The label used in configs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Setting::Isolated => "isolated",
+            Setting::Wall => "wall",
+            Setting::Lettuce => "lettuce",
+        }
+    }
+
+    /// Parses a label (`isolated`, `wall`, `lettuce`).
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == s)
     }
 }
 
@@ -129,6 +178,39 @@ impl Shape {
                 p.x.abs() <= half[0] && p.y.abs() <= half[1] && p.z.abs() <= half[2]
             }
         }
+    }
+
+    /// Outward unit normal of the surface nearest to `p` (body frame).
+    pub fn surface_normal(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        let n = match *self {
+            Shape::Disc {
+                radius,
+                half_height,
+            } => {
+                let r = (p.x * p.x + p.y * p.y).sqrt();
+                if half_height - p.z.abs() < radius - r || r < 1e-9 {
+                    Vector3::new(0.0, 0.0, p.z.signum())
+                } else {
+                    Vector3::new(p.x / r, p.y / r, 0.0)
+                }
+            }
+            Shape::Capsule { half_length, .. } => {
+                p - Vector3::new(p.x.clamp(-half_length, half_length), 0.0, 0.0)
+            }
+            Shape::Cuboid { half } => {
+                let gaps = [
+                    half[0] - p.x.abs(),
+                    half[1] - p.y.abs(),
+                    half[2] - p.z.abs(),
+                ];
+                let axis = (0..3).fold(0, |b, i| if gaps[i] < gaps[b] { i } else { b });
+                let mut n = Vector3::zeros();
+                n[axis] = p[axis].signum();
+                n
+            }
+        };
+        let norm = n.norm();
+        if norm < 1e-9 { Vector3::z() } else { n / norm }
     }
 
     /// Half extents of the axis-aligned bounding box (x major, y minor, z height).
@@ -283,7 +365,7 @@ impl FoodModel {
                 puncture_force: (7.5, 0.12),
                 puncture_indent: 0.0022,
                 cut_fraction: 0.25,
-                grip_per_m: (20.0, 0.3),
+                grip_per_m: (60.0, 0.3),
                 friction: (0.8, 0.2),
                 tear_per_m: (1500.0, 0.3),
                 cut_fraction_of_width: 0.5,
@@ -375,5 +457,23 @@ mod tests {
         assert_eq!(FoodKind::Cantaloupe.expert_action(), 1);
         assert_eq!(FoodKind::parse("carrot"), Some(FoodKind::Carrot));
         assert_eq!(FoodKind::parse("kiwi"), None);
+    }
+
+    #[test]
+    fn the_all_setting_is_the_mean_of_the_three() {
+        for kind in FoodKind::ALL {
+            for a in 0..6 {
+                let mean = Setting::ALL
+                    .iter()
+                    .map(|&s| kind.published_rates_in(s)[a])
+                    .sum::<f64>()
+                    / 3.0;
+                assert!(
+                    (mean - kind.published_rates()[a]).abs() < 0.006,
+                    "{kind:?} {a}"
+                );
+            }
+        }
+        assert_eq!(Setting::parse("wall"), Some(Setting::Wall));
     }
 }

@@ -30,10 +30,10 @@ pub mod skewer;
 
 pub use controller::{ACTIONS, Action};
 
-pub use calibrate::{CalibrationReport, CalibrationRow, calibrate};
+pub use calibrate::{CalibrationOptions, CalibrationReport, CalibrationRow, calibrate};
 pub use env::{KinovaFeedingConfig, KinovaFeedingEnv};
 pub use error::KinovaError;
-pub use food::{FoodKind, FoodModel, FoodProps, Shape};
+pub use food::{FoodKind, FoodModel, FoodProps, Setting, Shape};
 pub use sim::{AttemptReport, Simulator};
 
 /// Does nothing; calling it keeps this crate (and its typetag registrations)

@@ -57,11 +57,18 @@ pub struct SceneIds {
     pub wrist_force_adr: usize,
     /// Per food kind: body, geom, free-joint qpos address, dof address.
     pub food: [FoodIds; 3],
+    /// The lettuce leaf of the `lettuce` setting, if the scene has one.
+    pub lettuce: Option<FoodIds>,
     /// Body of the plate.
     pub plate_body: usize,
 }
 
-/// Model indices of one food item.
+/// Name of the lettuce leaf's body (free joint `lettuce_free`).
+pub const LETTUCE_BODY: &str = "lettuce";
+/// Name of the lettuce leaf's geom (a box).
+pub const LETTUCE_GEOM: &str = "lettuce_geom";
+
+/// Model indices of one free body (a food item or the leaf).
 #[derive(Clone, Copy, Debug)]
 pub struct FoodIds {
     /// Body id.
@@ -146,40 +153,26 @@ fn resolve(model: &MjModel, origin: &str) -> Result<SceneIds, KinovaError> {
         qpos: 0,
         dof: 0,
     }; 3];
-    let jnt_type = model.jnt_type();
     for kind in FoodKind::ALL {
-        let body = id(model, origin, mjOBJ_BODY, &kind.body_name())?;
-        let geom = id(model, origin, mjOBJ_GEOM, &kind.geom_name())?;
-        let joint = id(
-            model,
-            origin,
-            mjOBJ_JOINT,
-            &format!("{}_free", kind.body_name()),
-        )?;
-        if jnt_type[joint] != MjtJoint::mjJNT_FREE {
-            return Err(KinovaError::MjcfInvalid {
-                origin: origin.into(),
-                what: format!("joint `{}_free` must be a free joint", kind.body_name()),
-            });
-        }
         let want = match kind {
             FoodKind::Banana => MjtGeomBase::mjGEOM_CYLINDER,
             FoodKind::Carrot => MjtGeomBase::mjGEOM_CAPSULE,
             FoodKind::Cantaloupe => MjtGeomBase::mjGEOM_BOX,
         };
-        if model.geom_type()[geom] != want {
-            return Err(KinovaError::MjcfInvalid {
-                origin: origin.into(),
-                what: format!("geom `{}` must be of type {want:?}", kind.geom_name()),
-            });
-        }
-        food[kind.index()] = FoodIds {
-            body,
-            geom,
-            qpos: qposadr[joint] as usize,
-            dof: dofadr[joint] as usize,
-        };
+        food[kind.index()] = free_body(model, origin, &kind.body_name(), &kind.geom_name(), want)?;
     }
+    // The leaf is optional: a custom scene without one cannot stage the
+    // `lettuce` setting, and says so when asked to.
+    let lettuce = match model.name_to_id(mjOBJ_BODY, LETTUCE_BODY) {
+        Some(_) => Some(free_body(
+            model,
+            origin,
+            LETTUCE_BODY,
+            LETTUCE_GEOM,
+            MjtGeomBase::mjGEOM_BOX,
+        )?),
+        None => None,
+    };
     Ok(SceneIds {
         arm_qpos,
         arm_dof,
@@ -190,6 +183,39 @@ fn resolve(model: &MjModel, origin: &str) -> Result<SceneIds, KinovaError> {
         tine_sites,
         wrist_force_adr: model.sensor_adr()[sensor] as usize,
         food,
+        lettuce,
         plate_body: id(model, origin, mjOBJ_BODY, "plate")?,
+    })
+}
+
+/// Resolves a free body `body` with geom `geom` of type `want` (joint `{body}_free`).
+fn free_body(
+    model: &MjModel,
+    origin: &str,
+    body: &str,
+    geom: &str,
+    want: MjtGeomBase,
+) -> Result<FoodIds, KinovaError> {
+    use mujoco_rs::mujoco_c::_mjtObjBase::*;
+    let body_id = id(model, origin, mjOBJ_BODY, body)?;
+    let geom_id = id(model, origin, mjOBJ_GEOM, geom)?;
+    let joint = id(model, origin, mjOBJ_JOINT, &format!("{body}_free"))?;
+    if model.jnt_type()[joint] != MjtJoint::mjJNT_FREE {
+        return Err(KinovaError::MjcfInvalid {
+            origin: origin.into(),
+            what: format!("joint `{body}_free` must be a free joint"),
+        });
+    }
+    if model.geom_type()[geom_id] != want {
+        return Err(KinovaError::MjcfInvalid {
+            origin: origin.into(),
+            what: format!("geom `{geom}` must be of type {want:?}"),
+        });
+    }
+    Ok(FoodIds {
+        body: body_id,
+        geom: geom_id,
+        qpos: model.jnt_qposadr()[joint] as usize,
+        dof: model.jnt_dofadr()[joint] as usize,
     })
 }

@@ -1,18 +1,20 @@
 //! Simulated perception: what a camera over the plate would report about
 //! the target, with noise, and its embedding into a context vector.
 //!
-//! Raw features (`RAW_DIM` = 14), all from noisy observations:
+//! Raw features (`RAW_DIM` = 16), all from noisy observations:
 //! 0–2 mean colour (RGB), 3–5 extents along the major and minor axes and
 //! height (cm), 6 elongation (major/minor), 7 fill ratio of the footprint's
 //! bounding box (shape: disc ≈ 0.79, capsule ≈ 0.8–0.9, cube 1), 8 distance
 //! of the item's edge to the plate rim (cm), 9 distance to the nearest other
 //! item (cm, 15 when alone), 10 number of other items within 6 cm,
 //! 11–12 cos 2φ and sin 2φ of the major axis yaw φ, 13 radial offset from
-//! the plate centre (cm).
+//! the plate centre (cm), 14 height of the item's underside above the plate
+//! (cm, from depth: what it rests on), 15 share of green in a ring around
+//! the item (a lettuce leaf under it).
 //!
 //! The embedding standardises them and maps them to the configured
-//! dimension `d`: for `d ≤ 14` a fixed Gaussian random projection; for
-//! larger `d` the 14 standardised features followed by `d − 14` random
+//! dimension `d`: for `d ≤ 16` a fixed Gaussian random projection; for
+//! larger `d` the 16 standardised features followed by `d − 16` random
 //! Fourier features `√2·cos(w·z + b)` (w ~ N(0, 1/4), b ~ U[0, 2π)). The
 //! projection is drawn from `embedding_seed`, so contexts are comparable
 //! across runs.
@@ -28,7 +30,7 @@ use crate::food::Shape;
 use crate::sim::{PerceivedTarget, TruePose};
 
 /// Number of raw perception features.
-pub const RAW_DIM: usize = 14;
+pub const RAW_DIM: usize = 16;
 /// Radius of the plate's inner rim (m).
 pub const RIM_RADIUS: f64 = 0.100;
 
@@ -66,13 +68,14 @@ pub struct Observation {
     pub raw: [f64; RAW_DIM],
 }
 
-/// Perceives `target` among `poses` (the plate centre at `plate`).
+/// Perceives `target` among `poses` (the centre of the plate's top
+/// surface at `plate`).
 pub fn perceive(
     poses: &[TruePose],
     target: usize,
     shape: &Shape,
     colour: [f64; 3],
-    plate: [f64; 2],
+    plate: [f64; 3],
     noise: &PerceptionNoise,
     rng: &mut impl Rng,
 ) -> Observation {
@@ -138,6 +141,8 @@ pub fn perceive(
         (2.0 * yaw).cos(),
         (2.0 * yaw).sin(),
         100.0 * radial,
+        100.0 * (t.centre[2] - t.half_extents[2] - plate[2] + 0.001 * g()),
+        (if t.on_leaf { 0.6 } else { 0.0 } + 0.05 * g()).clamp(0.0, 1.0),
     ];
     Observation {
         target: PerceivedTarget {
@@ -165,6 +170,8 @@ const STANDARD: [(f64, f64); RAW_DIM] = [
     (0.0, 0.7),
     (0.0, 0.7),
     (4.0, 2.0),
+    (0.1, 0.15),
+    (0.2, 0.3),
 ];
 
 /// A fixed map from raw features to contexts of dimension `dim`.
@@ -229,7 +236,7 @@ mod tests {
     #[test]
     fn embedding_has_the_requested_dimension_and_is_fixed_by_its_seed() {
         let raw = [0.5; RAW_DIM];
-        for d in [1, 5, 14, 15, 64] {
+        for d in [1, 5, 16, 17, 64] {
             let e = Embedding::new(d, 3).embed(&raw);
             assert_eq!(e.len(), d);
             assert!(e.iter().all(|v| v.is_finite()));

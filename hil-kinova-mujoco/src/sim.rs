@@ -29,6 +29,8 @@ const LIFT: f64 = 0.06;
 const HOLD: f64 = 1.5;
 /// Smallest rotational inertia given to an item (kg·m²).
 const MIN_INERTIA: f64 = 3e-6;
+/// Height of the lettuce leaf's midrib above its blade (m, MJCF).
+const LEAF_RIB: f64 = 0.0035;
 /// Item height above the plate that counts as lifted (m).
 const LIFTED: f64 = 0.03;
 
@@ -43,6 +45,17 @@ pub struct Placement {
     pub yaw: f64,
 }
 
+/// Where the lettuce leaf lies (the `lettuce` setting) and which item rests on it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LeafPlacement {
+    /// Centre of the leaf on the plate (m, plate frame); the item is centred on it.
+    pub xy: [f64; 2],
+    /// Yaw of the leaf's long side (rad).
+    pub yaw: f64,
+    /// The item resting on the leaf.
+    pub under: FoodKind,
+}
+
 /// An item's true pose after settling.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct TruePose {
@@ -54,6 +67,8 @@ pub struct TruePose {
     pub yaw: f64,
     /// Half extents (major, minor, height) (m).
     pub half_extents: [f64; 3],
+    /// It rests on the lettuce leaf.
+    pub on_leaf: bool,
 }
 
 /// What the controller is told about the target: a noisy perceived pose.
@@ -127,6 +142,7 @@ pub struct Simulator {
     home: [f64; 6],
     plate_centre: Vector3<f64>,
     props: [Option<FoodProps>; 3],
+    leaf_under: Option<FoodKind>,
     target: Option<FoodKind>,
     dt: f64,
     timing: Timing,
@@ -168,6 +184,7 @@ impl Simulator {
             home,
             plate_centre,
             props: [None, None, None],
+            leaf_under: None,
             target: None,
             dt,
             timing: Timing::default(),
@@ -205,10 +222,12 @@ impl Simulator {
     }
 
     /// Places `items` on the plate (at most one per kind; the others are put
+    /// aside) and the lettuce leaf under one of them if `leaf` is given (else
     /// aside), lets them settle, and returns their true poses.
     pub fn stage(
         &mut self,
         items: &[Placement],
+        leaf: Option<LeafPlacement>,
         target: FoodKind,
     ) -> Result<Vec<TruePose>, KinovaError> {
         let start = Instant::now();
@@ -224,6 +243,28 @@ impl Simulator {
                 });
             }
             props[p.props.kind.index()] = Some(p.props.clone());
+        }
+        let leaf_ids = match (leaf, self.ids.lettuce) {
+            (Some(l), None) => {
+                return Err(KinovaError::MjcfMissing {
+                    origin: "scene".into(),
+                    kind: "body",
+                    name: format!(
+                        "{} (needed to put the {} on lettuce)",
+                        model::LETTUCE_BODY,
+                        l.under.name()
+                    ),
+                });
+            }
+            (_, ids) => ids,
+        };
+        if let Some(l) = leaf
+            && props[l.under.index()].is_none()
+        {
+            return Err(KinovaError::MjcfInvalid {
+                origin: "scene".into(),
+                what: format!("the {} on the lettuce is not on the plate", l.under.name()),
+            });
         }
         if props[target.index()].is_none() {
             return Err(KinovaError::MjcfInvalid {
@@ -249,6 +290,8 @@ impl Simulator {
         {
             let home = self.home;
             let ids = self.ids.clone();
+            let leaf_thickness =
+                leaf_ids.map_or(0.0, |l| 2.0 * self.data.model().geom_size()[l.geom][2]);
             let qpos = self.data.qpos_mut();
             for i in 0..6 {
                 qpos[ids.arm_qpos[i]] = home[i];
@@ -258,9 +301,13 @@ impl Simulator {
                 let (pos, yaw) = match items.iter().find(|p| p.props.kind == kind) {
                     Some(p) => {
                         let h = p.props.shape.half_extents()[2];
+                        let (xy, base) = match leaf {
+                            Some(l) if l.under == kind => (l.xy, leaf_thickness + LEAF_RIB),
+                            _ => (p.xy, 0.0),
+                        };
                         (
                             self.plate_centre
-                                + Vector3::new(p.xy[0], p.xy[1], PLATE_TOP + h + 0.0005),
+                                + Vector3::new(xy[0], xy[1], PLATE_TOP + base + h + 0.0005),
                             p.yaw,
                         )
                     }
@@ -269,15 +316,26 @@ impl Simulator {
                         0.0,
                     ),
                 };
-                let q = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw);
-                qpos[f.qpos..f.qpos + 3].copy_from_slice(pos.as_slice());
-                qpos[f.qpos + 3] = q.w;
-                qpos[f.qpos + 4] = q.i;
-                qpos[f.qpos + 5] = q.j;
-                qpos[f.qpos + 6] = q.k;
+                set_free_pose(&mut qpos[f.qpos..f.qpos + 7], pos, yaw);
+            }
+            if let Some(l) = leaf_ids {
+                let (pos, yaw) = match leaf {
+                    Some(p) => (
+                        self.plate_centre
+                            + Vector3::new(
+                                p.xy[0],
+                                p.xy[1],
+                                PLATE_TOP + 0.5 * leaf_thickness + 0.0002,
+                            ),
+                        p.yaw,
+                    ),
+                    None => (Vector3::new(-0.6, 0.6, 0.05), 0.0),
+                };
+                set_free_pose(&mut qpos[l.qpos..l.qpos + 7], pos, yaw);
             }
         }
         self.props = props;
+        self.leaf_under = leaf.map(|l| l.under);
         self.target = Some(target);
         self.set_ctrl(&self.home.clone(), [0.0, 0.0]);
         self.data.forward();
@@ -343,6 +401,7 @@ impl Simulator {
                     centre: self.data.xpos()[b],
                     yaw: r[(1, 0)].atan2(r[(0, 0)]),
                     half_extents: p.shape.half_extents(),
+                    on_leaf: self.leaf_under == Some(kind),
                 })
             })
             .collect()
@@ -493,7 +552,25 @@ impl Simulator {
         let tip0 = pre + travel * u;
         let mut lift = 0.0;
         step_i = 0;
+        let trace = std::env::var_os("HIL_TRACE").is_some();
         while lift < LIFT {
+            if trace && step_i % 40 == 0 {
+                let b = self.ids.food[target.index()].body;
+                eprintln!(
+                    "lift {:.3} z {:.4} tines {:?}",
+                    lift,
+                    self.data.xpos()[b][2] - self.plate_top_centre().z,
+                    skewer
+                        .tines()
+                        .iter()
+                        .map(|t| match t {
+                            crate::skewer::TineState::Pierced { s, cut, .. } =>
+                                format!("P s={s:.4} cut={cut:.4}"),
+                            o => format!("{o:?}").chars().take(12).collect(),
+                        })
+                        .collect::<Vec<_>>()
+                );
+            }
             lift += 0.10 * self.dt;
             if step_i % 2 == 0 {
                 let target = PoseTarget {
@@ -562,6 +639,16 @@ impl Simulator {
             })
         }
     }
+}
+
+/// Writes a free joint's position and a yaw-only orientation.
+fn set_free_pose(qpos: &mut [f64], pos: Vector3<f64>, yaw: f64) {
+    let q = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw);
+    qpos[..3].copy_from_slice(pos.as_slice());
+    qpos[3] = q.w;
+    qpos[4] = q.i;
+    qpos[5] = q.j;
+    qpos[6] = q.k;
 }
 
 fn wrench6(w: &Wrench) -> [f64; 6] {

@@ -6,7 +6,9 @@
 //! model turns the relative pose of each tine and each item into equal and
 //! opposite forces on the fork and the item (`xfrc_applied`). Per tine:
 //!
-//! 1. **Free** → **Indenting** when its tip enters an item. The surface
+//! 1. **Free** → **Indenting** when its tip enters an item at less than 45°
+//!    from the surface normal (a tip meeting a rounded flank more obliquely
+//!    skids past it: no force, it stays free). The surface
 //!    pushes back with `k·d` along the tine (`d` = travel past the entry
 //!    point) and holds the tip laterally by friction (at most half the
 //!    normal force, so a tilted tine can shove an item across the plate).
@@ -218,6 +220,12 @@ impl SkewerModel {
                                 self.stats.touched += 1;
                             }
                         }
+                        // A tip meeting the surface obliquely (a carrot's
+                        // flank) skids along it instead of digging in.
+                        let n = f.rot * props.shape.surface_normal(&local);
+                        if (-u).dot(&n) < GLANCE_COS {
+                            continue;
+                        }
                         return TineState::Indenting {
                             food: k,
                             entry: local,
@@ -346,6 +354,10 @@ impl SkewerModel {
         }
     }
 }
+
+/// Cosine of the largest angle between a tine and the surface normal at
+/// which the tip digs in (45°); steeper contacts glance off.
+const GLANCE_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
 /// Largest downward force passed to an item pressed against the plate (N).
 const PRESS_CAP: f64 = 1.0;

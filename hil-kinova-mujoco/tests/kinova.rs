@@ -80,7 +80,7 @@ fn every_action_reaches_its_commanded_pitch_and_roll() {
             xy: [0.01, -0.01],
             yaw,
         }];
-        let pose = sim.stage(&items, FoodKind::Cantaloupe).unwrap()[0];
+        let pose = sim.stage(&items, None, FoodKind::Cantaloupe).unwrap()[0];
         let perceived = PerceivedTarget {
             centre: pose.centre,
             yaw: pose.yaw,

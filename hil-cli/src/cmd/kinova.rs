@@ -14,8 +14,10 @@ use std::sync::Arc;
 
 use hil_core::config::{BuildContext, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
 use hil_core::{Environment, HilError, Result, Session, SessionSettings};
-use hil_kinova_mujoco::calibrate::calibrate_foods;
-use hil_kinova_mujoco::food::FoodKind;
+use std::io::Write;
+
+use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
+use hil_kinova_mujoco::food::{FoodKind, Setting};
 use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
 use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
 use serde::Serialize;
@@ -47,6 +49,16 @@ pub struct CalibrateArgs {
     /// Foods to run (default: all).
     #[arg(long, value_delimiter = ',')]
     pub foods: Vec<String>,
+    /// Placement settings the trials cycle through (default: isolated,wall,lettuce).
+    #[arg(long, value_delimiter = ',')]
+    pub settings: Vec<String>,
+    /// Worker threads, each with its own simulator (default: one per core).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Write every attempt (setting, seed, stop reason, forces, tine
+    /// counts, heights) to this file as JSON lines.
+    #[arg(long)]
+    pub attempts: Option<PathBuf>,
     /// Print a JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -111,6 +123,28 @@ pub fn demo(args: DemoArgs) -> Result<()> {
     }
 }
 
+fn parse_list<T>(
+    flag: &str,
+    given: &[String],
+    all: &[T],
+    parse: fn(&str) -> Option<T>,
+    expected: &str,
+) -> Result<Vec<T>>
+where
+    T: Copy,
+{
+    if given.is_empty() {
+        return Ok(all.to_vec());
+    }
+    given
+        .iter()
+        .map(|s| {
+            parse(s)
+                .ok_or_else(|| HilError::invalid_parameter(flag, s, format!("expected {expected}")))
+        })
+        .collect()
+}
+
 fn calibrate(args: CalibrateArgs) -> Result<()> {
     if args.trials == 0 {
         return Err(HilError::invalid_parameter(
@@ -119,24 +153,36 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             "must be at least 1",
         ));
     }
-    let foods: Vec<FoodKind> = if args.foods.is_empty() {
-        FoodKind::ALL.to_vec()
-    } else {
-        args.foods
-            .iter()
-            .map(|s| {
-                FoodKind::parse(s).ok_or_else(|| {
-                    HilError::invalid_parameter(
-                        "--foods",
-                        s,
-                        "unknown food; expected banana, carrot or cantaloupe",
-                    )
-                })
-            })
-            .collect::<Result<_>>()?
+    if args.threads == Some(0) {
+        return Err(HilError::invalid_parameter(
+            "--threads",
+            "0",
+            "must be at least 1",
+        ));
+    }
+    let opts = CalibrationOptions {
+        foods: parse_list(
+            "--foods",
+            &args.foods,
+            &FoodKind::ALL,
+            FoodKind::parse,
+            "banana, carrot or cantaloupe",
+        )?,
+        settings: parse_list(
+            "--settings",
+            &args.settings,
+            &Setting::ALL,
+            Setting::parse,
+            "isolated, wall or lettuce",
+        )?,
+        trials: args.trials,
+        seed: args.seed,
+        threads: args
+            .threads
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
     };
     let quiet = args.quiet;
-    let mut progress = |done: usize, total: usize| {
+    let progress = |done: usize, total: usize| {
         if !quiet && (done % 10 == 0 || done == total) {
             eprint!("\rsimulated {done}/{total} attempts");
             if done == total {
@@ -144,7 +190,32 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             }
         }
     };
-    let report = calibrate_foods(&foods, args.trials, args.seed, &mut progress)?;
+    let mut log_file = match &args.attempts {
+        Some(path) => Some((
+            path,
+            std::io::BufWriter::new(
+                std::fs::File::create(path).map_err(|e| HilError::io("create", path, e))?,
+            ),
+        )),
+        None => None,
+    };
+    let mut log_err: Option<HilError> = None;
+    let report = calibrate_with(&opts, &progress, &mut |record| {
+        if let (Some((path, w)), None) = (log_file.as_mut(), &log_err) {
+            let line = serde_json::to_string(record).map_err(|e| HilError::serde("attempt", e));
+            if let Err(e) = line.and_then(|l| {
+                writeln!(w, "{l}").map_err(|e| HilError::io("write", path.as_path(), e))
+            }) {
+                log_err = Some(e);
+            }
+        }
+    })?;
+    if let Some(e) = log_err {
+        return Err(e);
+    }
+    if let Some((path, mut w)) = log_file {
+        w.flush().map_err(|e| HilError::io("write", path, e))?;
+    }
     if args.json {
         println!(
             "{}",
@@ -152,31 +223,50 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         );
         return Ok(());
     }
+    let per_setting = opts.trials / opts.settings.len();
     println!(
-        "Simulated success rate (published rate) per action; {} trials each.",
-        args.trials
+        "Simulated success rate (published rate) per action; {} trials each ({} per setting).",
+        opts.trials, per_setting
     );
     println!("Simulated attempts with synthetic food properties; published: Feng et al. 2019.");
-    print!("{:<12}", "food");
-    for a in hil_core::FEEDING_ACTIONS {
-        print!("{a:>13}");
-    }
-    println!();
-    for chunk in report.rows.chunks(6) {
-        print!("{:<12}", chunk[0].food);
-        for r in chunk {
-            let p = r.published.map_or("  -  ".into(), |p| format!("{p:.2}"));
-            print!("{:>13}", format!("{:.2} ({p})", r.rate));
+    let header = || {
+        print!("{:<22}", "food");
+        for a in hil_core::FEEDING_ACTIONS {
+            print!("{a:>13}");
         }
         println!();
+    };
+    header();
+    for chunk in report.rows.chunks(6) {
+        print!("{:<22}", chunk[0].food);
+        for r in chunk {
+            print!("{:>13}", cell(r.rate, r.published));
+        }
+        println!();
+        for (i, c) in chunk[0].by_setting.iter().enumerate() {
+            print!("{:<22}", format!("  {}", c.setting.name()));
+            for r in chunk {
+                let c = &r.by_setting[i];
+                print!("{:>13}", cell(c.rate, c.published));
+            }
+            println!();
+        }
     }
     println!(
-        "mean |simulated - published| = {:.3}; {:.1} attempts/s; {:.1}% of time outside mj_step",
+        "mean |simulated - published| = {:.3} overall, {:.3} per setting; {:.1} attempts/s on {} threads ({:.1} per core); {:.1}% of time outside mj_step",
         report.mean_abs_error,
+        report.mean_abs_error_by_setting,
         report.attempts_per_second,
+        report.threads,
+        report.attempts_per_second_per_core,
         100.0 * report.overhead_share
     );
     Ok(())
+}
+
+fn cell(rate: f64, published: Option<f64>) -> String {
+    let p = published.map_or("  -  ".into(), |p| format!("{p:.2}"));
+    format!("{rate:.2} ({p})")
 }
 
 /// The methods of the user study, in the paper's order.

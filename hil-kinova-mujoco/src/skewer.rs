@@ -420,6 +420,33 @@ mod tests {
     }
 
     #[test]
+    fn a_tine_glances_off_a_rounded_flank_but_digs_into_the_crest() {
+        let carrot = item(FoodKind::Carrot);
+        let r = carrot.shape.half_extents()[1];
+        let foods = [FoodView {
+            pos: Vector3::zeros(),
+            rot: Matrix3::identity(),
+            com: Vector3::zeros(),
+            props: Some(&carrot),
+        }];
+        let mut out = [Wrench::default()];
+        // Straight down, just inside the surface: at the crest (y = 0) and on
+        // the flank 0.85 r off the axis (about 58° from the normal).
+        let mut state = |y: f64| {
+            let z = (r * r - y * y).sqrt() - 0.0002;
+            let mut m = SkewerModel::new(0, 0.001);
+            let t = TinePose {
+                tip: Vector3::new(0.0, y, z),
+                dir: -Vector3::z(),
+            };
+            m.step(&[t; N_TINES], Vector3::new(0.0, 0.0, 0.1), &foods, &mut out);
+            m.tines()[0]
+        };
+        assert!(matches!(state(0.0), TineState::Indenting { .. }));
+        assert_eq!(state(0.85 * r), TineState::Free);
+    }
+
+    #[test]
     fn a_soft_item_is_pierced_before_a_hard_one() {
         let banana = item(FoodKind::Banana);
         let carrot = item(FoodKind::Carrot);

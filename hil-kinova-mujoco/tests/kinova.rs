@@ -208,3 +208,102 @@ fn config_rejects_unknown_foods_and_fields() {
     let unknown: Result<KinovaFeedingConfig, _> = toml::from_str("colour = 3");
     assert!(unknown.is_err());
 }
+
+/// Stages one carrot in `setting` and returns the environment after `observe`.
+fn staged(setting: &str, seed: u64) -> KinovaFeedingEnv {
+    let mut env = KinovaFeedingEnv::new(KinovaFeedingConfig {
+        plate: vec!["carrot".into()],
+        settings: vec![setting.into()],
+        context_dim: 16,
+        ..KinovaFeedingConfig::default()
+    })
+    .unwrap();
+    env.reset(seed).unwrap();
+    env.next_item().unwrap();
+    env.observe().unwrap();
+    env
+}
+
+#[test]
+fn each_setting_places_the_item_where_it_says() {
+    use hil_kinova_mujoco::Setting;
+    let plate = Simulator::new().unwrap().plate_top_centre();
+    for seed in 0..4 {
+        let radial = |env: &KinovaFeedingEnv| {
+            let p = env.simulator().true_poses()[0];
+            (
+                ((p.centre[0] - plate.x).powi(2) + (p.centre[1] - plate.y).powi(2)).sqrt(),
+                p.centre[2] - p.half_extents[2] - plate.z,
+                p.on_leaf,
+            )
+        };
+        let env = staged("isolated", seed);
+        assert_eq!(env.current_setting(), Some(Setting::Isolated));
+        let (r, lift, leaf) = radial(&env);
+        assert!(r + 0.028 < 0.100, "isolated carrot {r} m from the centre");
+        assert!(
+            lift.abs() < 0.002 && !leaf,
+            "isolated carrot rests on the plate: {lift}"
+        );
+        // Against the rim: the carrot's side is within 3 mm of the rim's foot
+        // (radius 0.094) or already on its slope.
+        let (r, _, _) = radial(&staged("wall", seed));
+        assert!(r > 0.080, "wall carrot {r} m from the centre");
+        // On the leaf: raised by the leaf and its midrib.
+        let env = staged("lettuce", seed);
+        let (_, lift, leaf) = radial(&env);
+        assert!(leaf && lift > 0.002, "lettuce carrot raised {lift} m");
+        assert!(
+            env.current_item()
+                .unwrap()
+                .description
+                .as_deref()
+                .unwrap()
+                .contains("lettuce")
+        );
+    }
+}
+
+#[test]
+fn an_unknown_setting_is_a_clear_error() {
+    let err = KinovaFeedingEnv::new(KinovaFeedingConfig {
+        settings: vec!["bowl".into()],
+        ..KinovaFeedingConfig::default()
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("settings") && err.contains("bowl"), "{err}");
+}
+
+#[test]
+fn calibration_does_not_depend_on_the_number_of_threads() {
+    use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
+    let run = |threads| {
+        let opts = CalibrationOptions {
+            foods: vec![FoodKind::Banana],
+            trials: 3,
+            threads,
+            ..CalibrationOptions::default()
+        };
+        let mut log = Vec::new();
+        let report = calibrate_with(&opts, &|_, _| {}, &mut |r| log.push(r.clone())).unwrap();
+        (report.rows, log)
+    };
+    let (rows1, log1) = run(1);
+    let (rows2, log2) = run(2);
+    assert_eq!(rows1, rows2);
+    assert_eq!(log1.len(), 18);
+    for (a, b) in log1.iter().zip(&log2) {
+        assert_eq!(
+            (a.seed, a.setting, &a.report),
+            (b.seed, b.setting, &b.report)
+        );
+    }
+    // Trials cycle through the settings: one per setting here.
+    assert!(
+        rows1
+            .iter()
+            .all(|r| r.by_setting.iter().all(|c| c.trials == 1))
+    );
+    assert_eq!(rows1[4].published, Some(0.57)); // TA0, setting `all`
+}

@@ -237,9 +237,10 @@ struct Current {
 
 /// The Kinova Gen3 feeding simulation as an [`Environment`].
 ///
-/// Each item is a freshly drawn piece of the configured food; each
-/// `observe` places it (and the episode's remaining items) on the plate at
-/// random, lets them settle and perceives the target; `execute` runs the
+/// Each item is a freshly drawn piece of the configured food in a setting
+/// drawn from `settings` (isolated, against the rim, on lettuce); each
+/// `observe` places it (and the episode's remaining items) on the plate,
+/// lets them settle and perceives the target; `execute` runs the
 /// action through the controller and physics. `best_action` is the
 /// published best action for the food (what an informed caregiver names).
 #[derive(Debug)]

@@ -12,15 +12,20 @@ fn hil(args: &[&str]) -> std::process::Output {
 
 #[test]
 fn calibrate_prints_rates_beside_the_published_ones() {
+    let log =
+        std::env::temp_dir().join(format!("hil-kinova-attempts-{}.jsonl", std::process::id()));
+    // Three trials: one per setting, so the published `all` row applies.
     let out = hil(&[
         "kinova",
         "calibrate",
         "--trials",
-        "1",
+        "3",
         "--foods",
         "carrot",
         "--json",
         "--quiet",
+        "--attempts",
+        log.to_str().unwrap(),
     ]);
     assert!(
         out.status.success(),
@@ -32,6 +37,16 @@ fn calibrate_prints_rates_beside_the_published_ones() {
     assert_eq!(rows.len(), 6);
     assert_eq!(rows[1]["action"], "VS90");
     assert_eq!(rows[1]["published"], 0.53);
+    let by_setting = rows[1]["by_setting"].as_array().unwrap();
+    assert_eq!(by_setting.len(), 3);
+    assert_eq!(by_setting[0]["setting"], "isolated");
+    assert_eq!(by_setting[0]["published"], 1.0);
+    let attempts = std::fs::read_to_string(&log).unwrap();
+    let _ = std::fs::remove_file(&log);
+    assert_eq!(attempts.lines().count(), 18);
+    let first: serde_json::Value = serde_json::from_str(attempts.lines().next().unwrap()).unwrap();
+    assert_eq!(first["food"], "carrot");
+    assert!(first["report"]["stop"].is_string());
     assert!(
         rows.iter()
             .all(|r| (0.0..=1.0).contains(&r["rate"].as_f64().unwrap()))
@@ -41,6 +56,9 @@ fn calibrate_prints_rates_beside_the_published_ones() {
     let out = hil(&["kinova", "calibrate", "--foods", "kiwi"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("kiwi"));
+    let out = hil(&["kinova", "calibrate", "--settings", "bowl"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("bowl"));
 }
 
 #[test]

@@ -27,7 +27,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::controller::ACTIONS;
-use crate::food::{FoodKind, FoodModel, FoodProps, Setting};
+use crate::food::{FoodKind, FoodModel, FoodProps, Setting, parse_labels};
 use crate::model::MjcfSource;
 use crate::perception::{Embedding, Observation, PerceptionNoise, RIM_RADIUS, perceive};
 use crate::sim::{AttemptReport, KeyframeHook, LeafPlacement, Placement, Simulator};
@@ -96,47 +96,11 @@ impl Default for KinovaFeedingConfig {
 
 impl KinovaFeedingConfig {
     fn foods(&self) -> Result<Vec<FoodKind>> {
-        if self.plate.is_empty() {
-            return Err(HilError::invalid_parameter(
-                "plate",
-                "[]",
-                "needs at least one item",
-            ));
-        }
-        self.plate
-            .iter()
-            .map(|s| {
-                FoodKind::parse(s).ok_or_else(|| {
-                    HilError::invalid_parameter(
-                        "plate",
-                        format!("{s:?}"),
-                        "unknown food; expected banana, carrot or cantaloupe",
-                    )
-                })
-            })
-            .collect()
+        parse_labels("plate", &self.plate)
     }
 
     fn parsed_settings(&self) -> Result<Vec<Setting>> {
-        if self.settings.is_empty() {
-            return Err(HilError::invalid_parameter(
-                "settings",
-                "[]",
-                "needs at least one of isolated, wall, lettuce",
-            ));
-        }
-        self.settings
-            .iter()
-            .map(|s| {
-                Setting::parse(s).ok_or_else(|| {
-                    HilError::invalid_parameter(
-                        "settings",
-                        format!("{s:?}"),
-                        "unknown setting; expected isolated, wall or lettuce",
-                    )
-                })
-            })
-            .collect()
+        parse_labels("settings", &self.settings)
     }
 
     fn validate(&self) -> Result<()> {

@@ -41,7 +41,7 @@ impl FoodKind {
 
     /// Parses a label (`banana`, `carrot`, `cantaloupe`).
     pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == s)
+        parse_label(s)
     }
 
     /// Index in [`FoodKind::ALL`].
@@ -131,8 +131,83 @@ impl Setting {
 
     /// Parses a label (`isolated`, `wall`, `lettuce`).
     pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == s)
+        parse_label(s)
     }
+}
+
+/// A closed set of named values read from configs and flags (foods,
+/// settings): one parser and one error message serve them all.
+pub trait Label: Copy + 'static {
+    /// What one value is called in messages (`food`, `setting`).
+    const WHAT: &'static str;
+    /// Every value.
+    fn all() -> &'static [Self];
+    /// Its label.
+    fn label(self) -> &'static str;
+}
+
+impl Label for FoodKind {
+    const WHAT: &'static str = "food";
+    fn all() -> &'static [Self] {
+        &Self::ALL
+    }
+    fn label(self) -> &'static str {
+        self.name()
+    }
+}
+
+impl Label for Setting {
+    const WHAT: &'static str = "setting";
+    fn all() -> &'static [Self] {
+        &Self::ALL
+    }
+    fn label(self) -> &'static str {
+        self.name()
+    }
+}
+
+/// The value labelled `s`, if any.
+pub fn parse_label<T: Label>(s: &str) -> Option<T> {
+    T::all().iter().copied().find(|v| v.label() == s)
+}
+
+/// Parses the labels given for the config field or flag `field`; an empty
+/// list or an unknown label is an error naming the field and the choices.
+///
+/// ```
+/// use hil_kinova_mujoco::food::{FoodKind, parse_labels};
+///
+/// let foods: Vec<FoodKind> = parse_labels("plate", &["carrot".into()])?;
+/// assert_eq!(foods, [FoodKind::Carrot]);
+/// let err = parse_labels::<FoodKind>("plate", &["kiwi".into()]).unwrap_err();
+/// assert!(err.to_string().contains("kiwi"));
+/// # Ok::<(), hil_core::HilError>(())
+/// ```
+pub fn parse_labels<T: Label>(field: &str, values: &[String]) -> hil_core::Result<Vec<T>> {
+    let choices = T::all()
+        .iter()
+        .map(|v| v.label())
+        .collect::<Vec<_>>()
+        .join(", ");
+    if values.is_empty() {
+        return Err(hil_core::HilError::invalid_parameter(
+            field,
+            "[]",
+            format!("needs at least one of {choices}"),
+        ));
+    }
+    values
+        .iter()
+        .map(|s| {
+            parse_label(s).ok_or_else(|| {
+                hil_core::HilError::invalid_parameter(
+                    field,
+                    format!("{s:?}"),
+                    format!("unknown {}; expected one of {choices}", T::WHAT),
+                )
+            })
+        })
+        .collect()
 }
 
 /// The geometry of one item, in its body frame (+x is the major axis).

@@ -17,7 +17,7 @@ use hil_core::{Environment, HilError, Result, Session, SessionSettings};
 use std::io::Write;
 
 use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
-use hil_kinova_mujoco::food::{FoodKind, Setting};
+use hil_kinova_mujoco::food::{Label, parse_labels};
 use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
 use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
 use serde::Serialize;
@@ -123,26 +123,13 @@ pub fn demo(args: DemoArgs) -> Result<()> {
     }
 }
 
-fn parse_list<T>(
-    flag: &str,
-    given: &[String],
-    all: &[T],
-    parse: fn(&str) -> Option<T>,
-    expected: &str,
-) -> Result<Vec<T>>
-where
-    T: Copy,
-{
+/// The values named by a list flag, or all of them when it is not given.
+fn labels_or_all<T: Label>(flag: &str, given: &[String]) -> Result<Vec<T>> {
     if given.is_empty() {
-        return Ok(all.to_vec());
+        Ok(T::all().to_vec())
+    } else {
+        parse_labels(flag, given)
     }
-    given
-        .iter()
-        .map(|s| {
-            parse(s)
-                .ok_or_else(|| HilError::invalid_parameter(flag, s, format!("expected {expected}")))
-        })
-        .collect()
 }
 
 fn calibrate(args: CalibrateArgs) -> Result<()> {
@@ -161,20 +148,8 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         ));
     }
     let opts = CalibrationOptions {
-        foods: parse_list(
-            "--foods",
-            &args.foods,
-            &FoodKind::ALL,
-            FoodKind::parse,
-            "banana, carrot or cantaloupe",
-        )?,
-        settings: parse_list(
-            "--settings",
-            &args.settings,
-            &Setting::ALL,
-            Setting::parse,
-            "isolated, wall or lettuce",
-        )?,
+        foods: labels_or_all("--foods", &args.foods)?,
+        settings: labels_or_all("--settings", &args.settings)?,
         trials: args.trials,
         seed: args.seed,
         threads: args
@@ -190,30 +165,26 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             }
         }
     };
-    let mut log_file = match &args.attempts {
+    // Create the attempt log before the run, so a bad path fails at once.
+    let log_file = match &args.attempts {
         Some(path) => Some((
             path,
-            std::io::BufWriter::new(
-                std::fs::File::create(path).map_err(|e| HilError::io("create", path, e))?,
-            ),
+            std::fs::File::create(path).map_err(|e| HilError::io("create", path, e))?,
         )),
         None => None,
     };
-    let mut log_err: Option<HilError> = None;
-    let report = calibrate_with(&opts, &progress, &mut |record| {
-        if let (Some((path, w)), None) = (log_file.as_mut(), &log_err) {
-            let line = serde_json::to_string(record).map_err(|e| HilError::serde("attempt", e));
-            if let Err(e) = line.and_then(|l| {
-                writeln!(w, "{l}").map_err(|e| HilError::io("write", path.as_path(), e))
-            }) {
-                log_err = Some(e);
-            }
+    let mut records = Vec::new();
+    let report = calibrate_with(&opts, &progress, &mut |r| {
+        if log_file.is_some() {
+            records.push(r.clone());
         }
     })?;
-    if let Some(e) = log_err {
-        return Err(e);
-    }
-    if let Some((path, mut w)) = log_file {
+    if let Some((path, file)) = log_file {
+        let mut w = std::io::BufWriter::new(file);
+        for r in &records {
+            let line = serde_json::to_string(r).map_err(|e| HilError::serde("attempt", e))?;
+            writeln!(w, "{line}").map_err(|e| HilError::io("write", path, e))?;
+        }
         w.flush().map_err(|e| HilError::io("write", path, e))?;
     }
     if args.json {

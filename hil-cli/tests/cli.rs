@@ -1,13 +1,7 @@
 //! The `hil` binary as a user meets it.
 
-use std::process::Command;
-
-fn hil(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_hil"))
-        .args(args)
-        .output()
-        .expect("the hil binary runs")
-}
+mod common;
+use common::hil;
 
 #[test]
 fn version_and_help() {

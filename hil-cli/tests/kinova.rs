@@ -1,14 +1,8 @@
 //! `hil kinova calibrate` and `hil demo kinova` through the binary (small
 //! runs: the full ones take minutes).
 
-use std::process::Command;
-
-fn hil(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_hil"))
-        .args(args)
-        .output()
-        .expect("the hil binary runs")
-}
+mod common;
+use common::hil;
 
 #[test]
 fn calibrate_prints_rates_beside_the_published_ones() {

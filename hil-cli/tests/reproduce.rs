@@ -1,15 +1,11 @@
 //! `hil data` and `hil reproduce` end to end on a small generated dataset
 //! (d = 224, 2 images per setting) so that the debug build stays fast.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
-fn hil(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_hil"))
-        .args(args)
-        .output()
-        .expect("the hil binary runs")
-}
+use std::path::Path;
+
+use common::hil;
 
 fn text(o: &std::process::Output) -> String {
     format!(

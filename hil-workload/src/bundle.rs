@@ -93,6 +93,15 @@ pub fn build_bundle(
     };
     let sim_table = cross_validate(&refs, &[sim], opts)?;
     let note = "fitted on synthetic study data calibrated to the paper's published figures; not real participant data";
+    // Every bundled model records its data set, size, CV error and how it
+    // was chosen, followed by the synthetic-data note.
+    let provenance = |d: &Dataset, cv_test_mse: [f64; 3], how: String| Provenance {
+        dataset: Some(d.id.as_str().into()),
+        data: Some(data_label.into()),
+        n_pairs: Some(d.pairs.len()),
+        cv_test_mse: Some(cv_test_mse),
+        note: Some(format!("{how}; {note}")),
+    };
     let mut models = Vec::new();
     for (d, name) in [
         (&sets[0], "f1_sim"),
@@ -104,15 +113,11 @@ pub fn build_bundle(
         models.push(FittedModel::new(
             name,
             spec,
-            Provenance {
-                dataset: Some(d.id.as_str().into()),
-                data: Some(data_label.into()),
-                n_pairs: Some(d.pairs.len()),
-                cv_test_mse: Some([row.mean, row.std, row.median]),
-                note: Some(format!(
-                    "simulation variant (Granger H = 10, bounds [0.05, 1], w_0 ≤ 1); {note}"
-                )),
-            },
+            provenance(
+                d,
+                [row.mean, row.std, row.median],
+                "simulation variant (Granger H = 10, bounds [0.05, 1], w_0 ≤ 1)".into(),
+            ),
         ));
     }
     for (d, name) in [(&sets[0], "f1_real"), (&sets[2], "f12_real")] {
@@ -121,20 +126,18 @@ pub fn build_bundle(
         models.push(FittedModel::new(
             name,
             spec,
-            Provenance {
-                dataset: Some(d.id.as_str().into()),
-                data: Some(data_label.into()),
-                n_pairs: Some(d.pairs.len()),
-                cv_test_mse: Some([best.mean, best.std, best.median]),
-                note: Some(format!(
-                    "lowest median CV test MSE: {}{}{}; {note}",
+            provenance(
+                d,
+                [best.mean, best.std, best.median],
+                format!(
+                    "lowest median CV test MSE: {}{}{}",
                     best.candidate.label(),
                     best.candidate
                         .history()
                         .map_or(String::new(), |h| format!(" H = {h}")),
                     lambda.map_or(String::new(), |l| format!(", λ = {l}")),
-                )),
-            },
+                ),
+            ),
         ));
     }
     Ok((table, models))

@@ -168,6 +168,21 @@ impl Browser {
         }
     }
 
+    /// Waits until the page has taken its last answer down. The channel
+    /// returns as soon as the server has the answer, a moment before the
+    /// page hears back; a next question's controls must not be confused
+    /// with the previous question's, still on screen.
+    fn wait_until_no_question(&self) {
+        let deadline = Instant::now() + Duration::from_secs(20);
+        while self.script("return document.getElementById('query').hidden;") != json!(true) {
+            assert!(
+                Instant::now() < deadline,
+                "the answered question stayed on screen"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
     fn click(&self, css: &str) {
         let id = self.find(css);
         self.cmd("POST", &format!("/element/{id}/click"), json!({}));
@@ -393,6 +408,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     }
     browser.click("#choice-3");
     let (ch, r) = asking.join().unwrap();
+    browser.wait_until_no_question();
     assert_eq!(r.answer, Answer::Action { arm: ArmId(3) });
     assert_eq!(r.expert_arm, Some(ArmId(3)));
 
@@ -410,6 +426,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     }
     browser.keys(&["\u{E004}", "\u{E004}", "\u{E007}"]);
     let (ch, r) = asking.join().unwrap();
+    browser.wait_until_no_question();
     assert_eq!(r.answer, Answer::Action { arm: ArmId(2) });
 
     // 3. Bounding box drawn with a finger on the canvas.
@@ -423,6 +440,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     );
     browser.click("#send-box");
     let (ch, r) = asking.join().unwrap();
+    browser.wait_until_no_question();
     let Answer::BoundingBox { bbox } = r.answer else {
         panic!("{:?}", r.answer)
     };
@@ -442,6 +460,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.click("#region-8");
     browser.click("#send-box");
     let (ch, r) = asking.join().unwrap();
+    browser.wait_until_no_question();
     let Answer::BoundingBox { bbox } = r.answer else {
         panic!("{:?}", r.answer)
     };
@@ -458,6 +477,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.keys(&["\u{E014}", "\u{E014}", "\u{E014}"]); // ArrowRight ×3
     browser.click("#send-box");
     let (ch, r) = asking.join().unwrap();
+    browser.wait_until_no_question();
     let Answer::BoundingBox { bbox } = r.answer else {
         panic!("{:?}", r.answer)
     };
@@ -475,6 +495,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.type_into("#answer-text", "It rolls; try TV90");
     browser.click("#send-text");
     let (ch, r) = asking.join().unwrap();
+    browser.wait_until_no_question();
     assert_eq!(
         r.answer,
         Answer::Text {
@@ -491,6 +512,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.find("#choice-0.scan-focus");
     browser.keys(&[" "]);
     let (ch, r) = asking.join().unwrap();
+    browser.wait_until_no_question();
     assert_eq!(r.answer, Answer::Action { arm: ArmId(0) });
 
     // The page says the answer was received and waits for the next one.

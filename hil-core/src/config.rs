@@ -84,6 +84,21 @@ pub trait PolicyConfig: std::fmt::Debug + Send + Sync {
     /// Validates the parameters and builds the policy for the environment
     /// described by `ctx`.
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>>;
+
+    /// Whether the policy's decisions read the workload forecast. A protocol
+    /// runs a policy that does not once and scores it under every workload
+    /// model; one that does runs once per deciding model. The default
+    /// (`true`) is the safe assumption for a policy nobody described.
+    fn uses_workload_forecast(&self) -> bool {
+        true
+    }
+
+    /// Whether the policy's decisions depend on its own seed
+    /// ([`Policy::seed`]). A protocol runs a stochastic policy under several
+    /// policy seeds. The default (`true`) is the safe assumption.
+    fn is_stochastic(&self) -> bool {
+        true
+    }
 }
 
 /// A serialisable recipe for an [`Environment`].
@@ -182,8 +197,10 @@ impl ExperimentConfig {
     }
 }
 
-/// Loads the `plugins` an experiment file lists, relative to its directory.
-fn load_plugins(text: &str, path: &Path) -> std::result::Result<(), ConfigError> {
+/// Loads the `plugins` a config file lists (a top-level `plugins` array),
+/// relative to the file's directory. Call it before parsing the rest of a
+/// config of your own that names plugin types.
+pub fn load_plugins(text: &str, path: &Path) -> std::result::Result<(), ConfigError> {
     #[derive(Deserialize)]
     struct PluginsOnly {
         #[serde(default)]

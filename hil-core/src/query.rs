@@ -83,6 +83,83 @@ pub struct QueryKind {
     pub distraction: Distraction,
 }
 
+/// One spelling per variant, shared by `Display` and `FromStr` (and so by
+/// every CSV column, CLI flag and label that names a query variable).
+macro_rules! spelled {
+    ($t:ty, $what:literal, $($v:ident => $s:literal),+ $(,)?) => {
+        impl $t {
+            /// The variable's spelling, as configs and data files write it.
+            pub const fn as_str(self) -> &'static str {
+                match self { $(Self::$v => $s),+ }
+            }
+        }
+        impl std::fmt::Display for $t {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.as_str())
+            }
+        }
+        impl std::str::FromStr for $t {
+            type Err = crate::error::HilError;
+            fn from_str(s: &str) -> crate::error::Result<Self> {
+                match s.trim() {
+                    $($s => Ok(Self::$v),)+
+                    other => Err(crate::error::HilError::invalid_parameter(
+                        $what,
+                        format!("`{other}`"),
+                        format!("expected one of: {}", [$($s),+].join(", ")),
+                    )),
+                }
+            }
+        }
+    };
+}
+spelled!(ResponseType, "response type", Mcq => "mcq", BoundingBox => "bounding_box", OpenEnded => "open_ended");
+spelled!(Difficulty, "difficulty", Easy => "easy", Hard => "hard");
+spelled!(Distraction, "distraction", None => "none", Easy => "easy", Hard => "hard");
+
+/// `response/difficulty/distraction`, e.g. `mcq/easy/none`.
+///
+/// ```
+/// use hil_core::QueryKind;
+/// let k: QueryKind = "bounding_box/hard/easy".parse().unwrap();
+/// assert_eq!(k.to_string(), "bounding_box/hard/easy");
+/// // Trailing parts may be left out; they keep their defaults.
+/// assert_eq!("open_ended".parse::<QueryKind>().unwrap().to_string(), "open_ended/easy/none");
+/// assert!("mcq/medium".parse::<QueryKind>().is_err());
+/// ```
+impl std::fmt::Display for QueryKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}/{}/{}",
+            self.response, self.difficulty, self.distraction
+        )
+    }
+}
+
+impl std::str::FromStr for QueryKind {
+    type Err = crate::error::HilError;
+    fn from_str(s: &str) -> crate::error::Result<Self> {
+        let mut k = QueryKind::default();
+        let parts: Vec<&str> = s.split('/').map(str::trim).collect();
+        if parts.len() > 3 {
+            return Err(crate::error::HilError::invalid_parameter(
+                "query kind",
+                format!("`{s}`"),
+                "expected at most response/difficulty/distraction",
+            ));
+        }
+        for (i, part) in parts.iter().enumerate().filter(|(_, p)| !p.is_empty()) {
+            match i {
+                0 => k.response = part.parse()?,
+                1 => k.difficulty = part.parse()?,
+                _ => k.distraction = part.parse()?,
+            }
+        }
+        Ok(k)
+    }
+}
+
 /// Everything a channel needs to pose one query.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Query {

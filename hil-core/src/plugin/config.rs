@@ -79,9 +79,12 @@ impl QueryChannelConfig for PluginComponent {
     }
 }
 
-/// The config trait of each component kind.
-pub(crate) trait KindOf {
+/// The config trait of each component kind (`dyn PolicyConfig`, ...): lets
+/// [`component`] serve all four. Implemented for exactly those four.
+pub trait KindOf {
+    /// Which kind of component the config trait builds.
     const KIND: ComponentKind;
+    /// Wraps a plugin component as a config of this kind.
     fn from_plugin(c: PluginComponent) -> Box<Self>;
 }
 
@@ -101,8 +104,11 @@ kind_of!(WorkloadModelConfig, WorkloadModel);
 kind_of!(QueryChannelConfig, QueryChannel);
 
 /// Deserialises a component table: a plugin type if a loaded plugin
-/// registered its `type`, else whatever typetag knows.
-pub(crate) fn component<'de, D, T>(d: D) -> std::result::Result<Box<T>, D::Error>
+/// registered its `type`, else whatever typetag knows. Use it as
+/// `#[serde(deserialize_with = "hil_core::plugin::component")]` on a
+/// `Box<dyn PolicyConfig>` (or any of the four) field of a config file of
+/// your own, so that plugin types work there as in [`crate::ExperimentConfig`].
+pub fn component<'de, D, T>(d: D) -> std::result::Result<Box<T>, D::Error>
 where
     D: Deserializer<'de>,
     T: KindOf + ?Sized,
@@ -141,7 +147,7 @@ where
 }
 
 /// [`component`] for an optional field.
-pub(crate) fn optional_component<'de, D, T>(d: D) -> std::result::Result<Option<Box<T>>, D::Error>
+pub fn optional_component<'de, D, T>(d: D) -> std::result::Result<Option<Box<T>>, D::Error>
 where
     D: Deserializer<'de>,
     T: KindOf + ?Sized,

@@ -64,8 +64,7 @@ pub use abi::{
     ABI_VERSION, BuildFacts, DECLARATION_SYMBOL, FIXED_STR_LEN, FixedStr, MAGIC, PluginDeclaration,
     PluginHeader, RegisterFn, interface_layout,
 };
-pub use config::PluginComponent;
-pub(crate) use config::{component, optional_component};
+pub use config::{KindOf, PluginComponent, component, optional_component};
 pub use guard::{Guarded, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload};
 pub use registrar::{
     ComponentKind, EnvironmentFactory, Factory, ParamFormat, Params, PluginRegistrar,

@@ -31,7 +31,7 @@ fn step(t: u64) -> StepEvent {
             diagnostics: None,
             response: None,
             arm: ArmId(2),
-            wl: 0.5,
+            wl_t: 0.5,
         },
         outcome: Outcome {
             success: true,

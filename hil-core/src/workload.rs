@@ -211,8 +211,42 @@ impl<'a> WorkloadForecast<'a> {
     }
 }
 
-/// Tracks the workload state of one person through a session. The state
-/// starts at WL_0 and changes only when a query is asked.
+/// The paper's WL_t = f(WL_0, Q_t): `model`'s prediction at timestep `t` over
+/// the queries asked up to `t`, with WL_0 itself at t = 0 (before the first
+/// step). The one definition the session's per-step trace, the episode
+/// metrics (WL_T at the last step) and every plotted workload curve use.
+///
+/// ```
+/// use hil_core::workload::workload_at;
+/// use hil_core::{QueryHistory, QueryKind, testing::fixtures::CountingWorkload};
+/// let mut q = QueryHistory::new();
+/// q.push(3, QueryKind::default()).unwrap();
+/// let m = CountingWorkload::new(0.1);
+/// assert_eq!(workload_at(&m, 0.5, &q, 0).unwrap(), 0.5);
+/// assert!((workload_at(&m, 0.5, &q, 9).unwrap() - 0.6).abs() < 1e-12);
+/// ```
+pub fn workload_at(
+    model: &dyn WorkloadModel,
+    wl0: f64,
+    history: &QueryHistory,
+    t: Timestep,
+) -> Result<f64> {
+    if t == 0 {
+        return Ok(wl0);
+    }
+    let wl = model.predict(wl0, history, t)?;
+    if !wl.is_finite() {
+        return Err(HilError::invalid_input(
+            format!("workload prediction of `{}`", model.name()),
+            format!("{wl} is not finite at t = {t}"),
+        ));
+    }
+    Ok(wl)
+}
+
+/// Tracks the workload of one person through a session: the queries asked
+/// so far and WL_t = f(WL_0, Q_t) ([`workload_at`]) at the current step, so
+/// a model whose workload decays between queries decays here too.
 ///
 /// ```
 /// use std::sync::Arc;
@@ -227,6 +261,7 @@ impl<'a> WorkloadForecast<'a> {
 /// let mut tr = WorkloadTracker::new(Arc::new(PerQuery), 0.5).unwrap();
 /// assert_eq!(tr.current(), 0.5);
 /// tr.record(4, QueryKind::default()).unwrap();
+/// assert!((tr.advance(4).unwrap() - 0.6).abs() < 1e-12);
 /// assert!((tr.current() - 0.6).abs() < 1e-12);
 /// ```
 #[derive(Clone)]
@@ -260,21 +295,20 @@ impl WorkloadTracker {
         })
     }
 
-    /// Records a query at `t` and updates the workload state.
-    pub fn record(&mut self, t: Timestep, kind: QueryKind) -> Result<f64> {
-        self.history.push(t, kind)?;
-        let wl = self.model.predict(self.wl0, &self.history, t)?;
-        if !wl.is_finite() {
-            return Err(HilError::invalid_input(
-                format!("workload prediction of `{}`", self.model.name()),
-                format!("{wl} is not finite"),
-            ));
-        }
-        self.current = wl;
-        Ok(wl)
+    /// Records a query asked at `t` (the person was interrupted, whatever
+    /// they answered). Call [`WorkloadTracker::advance`] to evaluate WL_t.
+    pub fn record(&mut self, t: Timestep, kind: QueryKind) -> Result<()> {
+        self.history.push(t, kind)
     }
 
-    /// The current workload state WL_t.
+    /// Evaluates WL_t at timestep `t` over the queries recorded so far and
+    /// makes it the current workload.
+    pub fn advance(&mut self, t: Timestep) -> Result<f64> {
+        self.current = workload_at(self.model.as_ref(), self.wl0, &self.history, t)?;
+        Ok(self.current)
+    }
+
+    /// WL_t at the last [`WorkloadTracker::advance`] (WL_0 before the first).
     pub fn current(&self) -> f64 {
         self.current
     }

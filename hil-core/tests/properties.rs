@@ -58,9 +58,9 @@ proptest! {
         for e in &r.events {
             let st = &e.step;
             if !st.decision.is_query() {
-                prop_assert_eq!(st.wl, prev_wl);
+                prop_assert_eq!(st.wl_t, prev_wl);
             }
-            prev_wl = st.wl;
+            prev_wl = st.wl_t;
             // After a query answered at an item, that item follows the expert.
             if let Some((item, arm)) = expert {
                 if item == st.item_index {

@@ -329,12 +329,33 @@ fn a_step_that_cannot_be_logged_stops_the_session_before_the_robot_acts() {
         }),
         response: None,
         arm: ArmId(0),
-        wl: 0.5,
+        wl_t: 0.5,
     };
     let err = rec.before_execute(&step).unwrap_err().to_string();
     assert!(err.contains("non-finite"), "{err}");
     // Nothing unreadable reached the log.
     let (_, logged) = RecordLog::open(&path).unwrap();
     assert!(logged.records.is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_log_of_the_previous_format_version_is_refused_and_says_why() {
+    let dir = tmp_dir("version");
+    let path = dir.join("log.jsonl");
+    full_run(&path);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let current = format!(r#""version":{}"#, hil_core::record::FORMAT_VERSION);
+    assert!(text.contains(&current));
+    std::fs::write(&path, text.replacen(&current, r#""version":1"#, 1)).unwrap();
+    match RecordLog::open(&path).unwrap_err() {
+        HilError::Data {
+            record, field, why, ..
+        } => {
+            assert_eq!((record, field.as_str()), (1, "version"));
+            assert!(why.contains("version 1"), "{why}");
+        }
+        e => panic!("expected a data error, got {e:?}"),
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

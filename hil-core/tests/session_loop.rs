@@ -111,7 +111,7 @@ fn hand_worked_episode() {
         ev[2].step.diagnostics.is_none(),
         "policy not consulted after a query"
     );
-    let wl: Vec<f64> = ev.iter().map(|e| e.step.wl).collect();
+    let wl: Vec<f64> = ev.iter().map(|e| e.step.wl_t).collect();
     for (w, expect) in wl.iter().zip([0.5, 0.6, 0.6, 0.6, 0.6, 0.6, 0.6]) {
         assert!((w - expect).abs() < 1e-12, "{wl:?}");
     }
@@ -203,7 +203,7 @@ fn item_ends_after_n_att_attempts() {
         assert_eq!(r.metrics.n_items, 2);
         assert_eq!(r.metrics.f_fail_food, 0.5);
         // Never queried: the workload never moved.
-        assert!(r.events.iter().all(|e| e.step.wl == 0.5));
+        assert!(r.events.iter().all(|e| e.step.wl_t == 0.5));
         assert_eq!(r.metrics.delta_wl, 0.0);
     }
 }
@@ -243,7 +243,7 @@ fn declined_query_falls_back_and_still_costs_workload() {
         [2, 1, 0],
         "fallback arms are executed, the policy is asked again"
     );
-    let wl: Vec<f64> = r.events.iter().map(|e| e.step.wl).collect();
+    let wl: Vec<f64> = r.events.iter().map(|e| e.step.wl_t).collect();
     assert!(
         (wl[0] - 0.7).abs() < 1e-12 && (wl[1] - 0.7).abs() < 1e-12 && (wl[2] - 0.9).abs() < 1e-12,
         "{wl:?}"
@@ -363,4 +363,112 @@ fn conformance_catches_a_broken_environment() {
     )
     .unwrap_err();
     assert_eq!(err.check, "replayable");
+}
+
+/// A model whose workload decays: each query adds 0.3, forgotten 2 steps
+/// later; 0.1 below WL_0 without recent queries.
+struct Decaying;
+impl hil_core::WorkloadModel for Decaying {
+    fn name(&self) -> &str {
+        "decaying"
+    }
+    fn predict(
+        &self,
+        wl0: f64,
+        h: &hil_core::QueryHistory,
+        t: hil_core::Timestep,
+    ) -> hil_core::Result<f64> {
+        Ok(wl0 - 0.1 + 0.3 * h.recent(t, 2).count() as f64)
+    }
+}
+
+#[test]
+fn workload_is_the_models_wl_t_at_every_step_and_scored_at_the_last() {
+    // The paper's WL_T = f(WL_0, Q_T) at the last step: a model that decays
+    // between queries decays in the trace and in ΔWL, not only at queries.
+    let mut env = TableEnv::new(actions(), vec![("pear", vec![0.0, 0.0, 0.0])]).unwrap();
+    let mut policy = ScriptedPolicy::new(3, 3, vec![query(2), act(1), act(1), act(1)]);
+    let mut channel = Decliner(0);
+    let r = Session {
+        settings: SessionSettings {
+            n_att: 4,
+            ..Default::default()
+        },
+        environment: &mut env,
+        policy: &mut policy,
+        channel: &mut channel,
+        workload: Arc::new(Decaying),
+        forecast: None,
+    }
+    .run_episode(0, &mut [])
+    .unwrap();
+    let wl: Vec<f64> = r.events.iter().map(|e| e.step.wl_t).collect();
+    let expect = [0.7, 0.7, 0.4, 0.4];
+    assert!(
+        wl.iter().zip(expect).all(|(a, b)| (a - b).abs() < 1e-12),
+        "{wl:?}"
+    );
+    let m = &r.metrics;
+    assert_eq!((m.t_final, m.n_q, m.queries.len()), (4, 1, 1));
+    assert!((m.wl_final - 0.4).abs() < 1e-12 && (m.delta_wl + 0.1).abs() < 1e-12);
+    // Rescoring under another model changes the workload figures only.
+    let other = m.rescored(&CountingWorkload::new(0.2)).unwrap();
+    assert!((other.delta_wl - 0.2).abs() < 1e-12);
+    assert_eq!(other.scoring_model, "counting");
+    assert_eq!(
+        (other.r_task_avg, other.f_q, other.n_q),
+        (m.r_task_avg, m.f_q, m.n_q)
+    );
+    // A policy that never asks is scored at f(WL_0, ∅), not at WL_0.
+    let mut policy = ScriptedPolicy::new(3, 3, vec![act(1)]);
+    let r = Session {
+        settings: SessionSettings {
+            n_att: 2,
+            ..Default::default()
+        },
+        environment: &mut env,
+        policy: &mut policy,
+        channel: &mut channel,
+        workload: Arc::new(Decaying),
+        forecast: None,
+    }
+    .run_episode(0, &mut [])
+    .unwrap();
+    assert!((r.metrics.delta_wl + 0.1).abs() < 1e-12, "{:?}", r.metrics);
+}
+
+#[test]
+fn explicit_component_seeds_reach_each_component() {
+    // The environment replays by its own seed whatever the episode's label.
+    let run = |label: u64, env_seed: u64| {
+        let mut env = TableEnv::new(
+            actions(),
+            vec![("a", vec![0.3, 0.5, 0.7]), ("b", vec![0.6, 0.2, 0.4])],
+        )
+        .unwrap();
+        let mut policy = ScriptedPolicy::new(3, 4, vec![act(0), act(1), act(2)]);
+        let mut channel = OracleChannel::default();
+        let seeds = hil_core::session::ComponentSeeds {
+            environment: env_seed,
+            policy: 1,
+            channel: 2,
+        };
+        let r = Session {
+            settings: SessionSettings::default(),
+            environment: &mut env,
+            policy: &mut policy,
+            channel: &mut channel,
+            workload: Arc::new(CountingWorkload::new(0.1)),
+            forecast: None,
+        }
+        .run_episode_with_seeds(label, seeds, &mut [])
+        .unwrap();
+        assert_eq!(r.seed, label);
+        r.events
+            .iter()
+            .map(|e| (e.step.context.clone(), e.outcome.success))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(run(1, 42), run(2, 42));
+    assert_ne!(run(1, 42), run(1, 43));
 }

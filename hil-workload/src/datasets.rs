@@ -214,10 +214,4 @@ impl Dataset {
     }
 }
 
-/// Mean and population standard deviation.
-pub fn mean_std(xs: &[f64]) -> (f64, f64) {
-    let n = xs.len().max(1) as f64;
-    let m = xs.iter().sum::<f64>() / n;
-    let v = xs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / n;
-    (m, v.sqrt())
-}
+pub use hil_core::metrics::mean_std;

@@ -13,7 +13,12 @@ use crate::time::Timestep;
 /// The `format` field of every log header.
 pub const FORMAT_NAME: &str = "hil-interaction-record";
 /// The version of the format this crate writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+///
+/// - 2: a step's workload is `wl_t`, the paper's WL_t = f(WL_0, Q_t) at every
+///   step, and episode metrics score WL_T at the last step (with `t_final`,
+///   `queries` and `scoring_model`);
+/// - 1: a step's `wl` was the workload tracked at query steps only.
+pub const FORMAT_VERSION: u32 = 2;
 
 /// The first line of a log: everything needed to rebuild the session.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -155,15 +155,30 @@ fn parse(path: &Path, bytes: &[u8], truncated_bytes: u64) -> Result<LoggedSessio
             .map_err(|e| data_err(line, "record", format!("not a valid record: {e}")))?;
         match (&record, line) {
             (Record::Header(h), 1) => {
-                if h.format != FORMAT_NAME || h.version != FORMAT_VERSION {
+                if h.format != FORMAT_NAME {
                     return Err(data_err(
                         1,
                         "format",
-                        format!(
-                            "`{}` version {} is not `{FORMAT_NAME}` version {FORMAT_VERSION}",
-                            h.format, h.version
-                        ),
+                        format!("`{}` is not `{FORMAT_NAME}`", h.format),
                     ));
+                }
+                if h.version != FORMAT_VERSION {
+                    let why = if h.version < FORMAT_VERSION {
+                        format!(
+                            "the log was written in format version {}, which tracked workload \
+                             only at query steps; this hil writes version {FORMAT_VERSION}, \
+                             which scores WL_T as the paper does, and cannot resume it: \
+                             run the session again from its config",
+                            h.version
+                        )
+                    } else {
+                        format!(
+                            "the log was written in format version {} by a newer hil; this \
+                             one reads version {FORMAT_VERSION}",
+                            h.version
+                        )
+                    };
+                    return Err(data_err(1, "version", why));
                 }
                 header = Some(h.clone());
             }

@@ -7,9 +7,9 @@
 //!
 //! | record | when | fields |
 //! |---|---|---|
-//! | `header` | first line | `format` (`hil-interaction-record`), `version` (1), `seed`, `episodes`, `config_path`, `base_dir`, `config` (the experiment TOML, verbatim) |
+//! | `header` | first line | `format` (`hil-interaction-record`), `version` (2), `seed`, `episodes`, `config_path`, `base_dir`, `config` (the experiment TOML, verbatim) |
 //! | `episode_start` | episode begins | `episode`, `seed` |
-//! | `step` | decided, **fsync'ed before the robot acts** | `episode`, `step`: `t`, `item_index`, `item_label`, `attempt`, `context`, `decision` (`act` / `query` with its `kind` = response type, difficulty, distraction, and `fallback` / `follow_expert`), `diagnostics`, `response` (answer, expert arm, response time; a `timed_out` answer means the policy acted on its own), `arm`, `wl` (WL_t) |
+//! | `step` | decided, **fsync'ed before the robot acts** | `episode`, `step`: `t`, `item_index`, `item_label`, `attempt`, `context`, `decision` (`act` / `query` with its `kind` = response type, difficulty, distraction, and `fallback` / `follow_expert`), `diagnostics`, `response` (answer, expert arm, response time; a `timed_out` answer means the policy acted on its own), `arm`, `wl_t` (WL_t = f(WL_0, Q_t) at this step) |
 //! | `outcome` | after execution, fsync'ed | `episode`, `t`, `outcome` (`success`, `success_probability`) |
 //! | `episode_end` | episode ends | `episode`, `metrics` |
 //! | `checkpoint` | after `episode_end`, if the policy can save its state | `episode`, `policy` (its [`crate::Policy::save`]) |

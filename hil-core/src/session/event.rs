@@ -63,8 +63,11 @@ pub struct PendingStep {
     pub response: Option<Response>,
     /// The arm that is executed.
     pub arm: ArmId,
-    /// The workload state WL_t after this step's query (if any).
-    pub wl: f64,
+    /// The workload trace: WL_t = f(WL_0, Q_t) at this step under the
+    /// session's workload model, counting this step's query if any
+    /// ([`crate::workload::workload_at`]). The last step's value is the
+    /// episode's WL_T.
+    pub wl_t: f64,
 }
 
 /// One completed step of a session.

@@ -7,7 +7,9 @@
 //!   item, the expert's action is executed again on every later attempt at
 //!   that item (the policy is not consulted, but observes every outcome).
 //! - An item ends on success or after `n_att` attempts.
-//! - Workload is tracked from WL_0 and changes only at query steps.
+//! - Workload is the paper's WL_t = f(WL_0, Q_t), evaluated at every step
+//!   with the session's workload model; the episode is scored at its last
+//!   step (WL_T, [`EpisodeMetrics`]).
 
 pub mod event;
 pub mod observer;
@@ -87,7 +89,10 @@ pub struct ComponentSeeds {
 }
 
 impl ComponentSeeds {
-    /// Derives the component seeds from `seed` (SplitMix64 streams).
+    /// Derives the component seeds from `seed` (SplitMix64 streams). This is
+    /// what [`Session::run_episode`] does; a protocol that crosses
+    /// environment seeds with policy seeds sets them explicitly and calls
+    /// [`Session::run_episode_with_seeds`].
     pub fn derive(seed: u64) -> Self {
         Self {
             environment: splitmix(seed, 1),
@@ -154,15 +159,26 @@ impl std::fmt::Debug for Session<'_> {
 }
 
 impl Session<'_> {
-    /// Runs one episode seeded by `seed`, reporting to `observers`.
+    /// Runs one episode seeded by `seed` (each component's seed derived from
+    /// it, [`ComponentSeeds::derive`]), reporting to `observers`.
     pub fn run_episode(
         &mut self,
         seed: u64,
         observers: &mut [&mut dyn SessionObserver],
     ) -> Result<EpisodeReport> {
+        self.run_episode_with_seeds(seed, ComponentSeeds::derive(seed), observers)
+    }
+
+    /// Runs one episode with explicit per-component seeds; `seed` labels
+    /// the episode in its report and for observers.
+    pub fn run_episode_with_seeds(
+        &mut self,
+        seed: u64,
+        seeds: ComponentSeeds,
+        observers: &mut [&mut dyn SessionObserver],
+    ) -> Result<EpisodeReport> {
         self.settings.validate()?;
         self.check_shapes()?;
-        let seeds = ComponentSeeds::derive(seed);
         self.environment.reset(seeds.environment)?;
         self.policy.seed(seeds.policy);
         self.channel.seed(seeds.channel);
@@ -248,6 +264,7 @@ impl Session<'_> {
                         }
                     }
                 };
+                let wl_t = tracker.advance(t)?;
                 let pending = PendingStep {
                     t,
                     item_index: item.index,
@@ -258,7 +275,7 @@ impl Session<'_> {
                     diagnostics,
                     response,
                     arm,
-                    wl: tracker.current(),
+                    wl_t,
                 };
                 for o in observers.iter_mut() {
                     o.before_execute(&pending)?;
@@ -294,7 +311,8 @@ impl Session<'_> {
             }
             items_seen += 1;
         }
-        let metrics = EpisodeMetrics::from_events(&events, self.settings.wl0)?;
+        let metrics =
+            EpisodeMetrics::from_events(&events, self.settings.wl0, self.workload.as_ref())?;
         for o in observers.iter_mut() {
             o.on_episode_end(&metrics)?;
         }

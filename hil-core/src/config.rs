@@ -54,6 +54,58 @@ pub struct BuildContext {
     /// Offline (context, arm, reward) data the environment offers for
     /// pretraining (see [`EnvironmentConfig::pretraining`]).
     pub pretraining: Option<Arc<[LabelledObservation]>>,
+    /// Work shared by every component built from this context (and its
+    /// clones): a protocol that builds hundreds of policies from one context
+    /// pretrains each distinct estimator once.
+    pub memo: Arc<BuildMemo>,
+}
+
+/// A cache of values derived from a [`BuildContext`] (e.g. an estimator
+/// pretrained on its `pretraining` data), keyed by a string that must name
+/// everything the value depends on besides the context itself.
+///
+/// ```
+/// let ctx = hil_core::BuildContext::new(".", 0);
+/// let a: u32 = ctx.memo.get_or_try_insert("answer", || Ok(42)).unwrap();
+/// let b: u32 = ctx.clone().memo.get_or_try_insert("answer", || Ok(0)).unwrap();
+/// assert_eq!((a, b), (42, 42));
+/// ```
+#[derive(Default)]
+pub struct BuildMemo {
+    values: std::sync::Mutex<
+        std::collections::HashMap<String, Arc<dyn std::any::Any + Send + Sync>>,
+    >,
+}
+
+impl std::fmt::Debug for BuildMemo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let n = self.values.lock().map_or(0, |m| m.len());
+        f.debug_struct("BuildMemo").field("values", &n).finish()
+    }
+}
+
+impl BuildMemo {
+    /// The value under `key`, computed by `make` the first time. The lock is
+    /// held while `make` runs, so concurrent builders compute it once. A
+    /// value of another type under the same key is an error.
+    pub fn get_or_try_insert<T, F>(&self, key: &str, make: F) -> Result<T>
+    where
+        T: Clone + Send + Sync + 'static,
+        F: FnOnce() -> Result<T>,
+    {
+        let mut values = self.values.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(v) = values.get(key) {
+            return v.downcast_ref::<T>().cloned().ok_or_else(|| {
+                crate::HilError::state(
+                    "build memo",
+                    format!("the value under `{key}` has another type"),
+                )
+            });
+        }
+        let v = make()?;
+        values.insert(key.to_string(), Arc::new(v.clone()));
+        Ok(v)
+    }
 }
 
 impl BuildContext {
@@ -65,6 +117,7 @@ impl BuildContext {
             action_space: None,
             context_dim: None,
             pretraining: None,
+            memo: Arc::default(),
         }
     }
 

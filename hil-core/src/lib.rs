@@ -44,7 +44,7 @@ pub mod testing;
 
 pub use action::{ActionSpace, ArmId, FEEDING_ACTIONS};
 pub use channel::QueryChannel;
-pub use config::{BuildContext, ConfigError, ExperimentConfig};
+pub use config::{BuildContext, BuildMemo, ConfigError, ExperimentConfig};
 pub use context::Context;
 pub use decision::{ArmDiagnostics, Choice, Decision, Diagnostics, LabelledObservation, Outcome};
 pub use environment::{Environment, Item};

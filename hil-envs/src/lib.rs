@@ -8,11 +8,10 @@
 //!   calibrated to; [`generate`]: the seeded synthetic dataset generator;
 //! - [`DatasetReplayEnv`]: the dataset-replay [`hil_core::Environment`]
 //!   (config type `food_replay`);
-//! - [`split`]: food-level pretrain / validation / test splits;
-//! - [`protocol`]: the paper's experiment protocol (runs, hyperparameter
-//!   selection on validation, evaluation on test, the cross-data experiment);
-//! - [`report`] and [`plot`]: results JSON, Markdown tables beside the
-//!   paper's published numbers ([`published`]), SVG figures.
+//! - [`split`]: food-level pretrain / validation / test splits.
+//!
+//! The paper's protocol that runs on this environment, with its tables and
+//! figures, is in the `hil-experiments` crate.
 //!
 //! **The bundled dataset is synthetic**, calibrated to published figures; it
 //! is not the paper's data, and results computed from it are not the paper's
@@ -22,13 +21,7 @@ pub mod dataset;
 pub mod env;
 pub mod generate;
 pub mod npy;
-pub mod output;
-pub mod plot;
-pub mod protocol;
-pub mod published;
 pub mod rates;
-pub mod report;
-pub mod results;
 pub mod split;
 
 use std::sync::{Arc, OnceLock};

@@ -4,3 +4,23 @@
 //! crates and tests run the same experiments: the simulated testbed, the
 //! user-study protocol, aggregation with uncertainty, tables and figures, and
 //! the paper's published tables as data.
+//!
+//! - [`testbed`]: the paper's simulated-testbed protocol (methods as policy
+//!   configs, runs in parallel, hyperparameters chosen on validation, the
+//!   cross-data experiment);
+//! - [`results`]: selection and aggregation; [`report`]: Markdown tables
+//!   beside the paper's published numbers ([`published`], read from data
+//!   files); [`plot`]: SVG figures; [`output`]: writes them all.
+//!
+//! Results computed from hil's bundled data are **synthetic, calibrated to
+//! published figures**: they are not the paper's results, and every table and
+//! figure says so.
+
+pub mod output;
+pub mod plot;
+pub mod published;
+pub mod report;
+pub mod results;
+pub mod testbed;
+
+pub use testbed::{Method, NamedModel, Protocol, ProtocolSettings};

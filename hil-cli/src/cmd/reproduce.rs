@@ -1,24 +1,19 @@
 //! `hil reproduce`: rerun every simulated experiment of the paper.
 //!
-//! The protocol itself lives in `hil_envs::protocol` (it only knows the
-//! `Policy` and `WorkloadModel` traits); this command supplies the paper's
-//! policies (hil-policies, one estimator pretrained once and cloned per run)
-//! and the bundled simulation workload models (hil-workload).
+//! Argument handling only: the protocol, its aggregation, tables and figures
+//! are `hil_experiments`; the methods are policy configs (built-in or plugin
+//! types) listed in the protocol settings; the workload models are
+//! hil-workload's bundled simulation models.
 
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use hil_core::{HilError, Policy, QueryKind};
-use hil_envs::env::{PretrainReward, pretraining_data};
-use hil_envs::output::{Timing, write_outputs};
-use hil_envs::protocol::{Family, NamedModel, PolicySpec, Protocol, ProtocolSettings};
-use hil_envs::results::aggregate;
+use hil_core::HilError;
 use hil_envs::{FoodDataset, bundled_dataset};
-use hil_policies::{
-    AlwaysQuery, AlwaysQueryParams, LinUcb, LinUcbExpDecay, LinUcbExpDecayParams, LinUcbParams,
-    LinUcbQg, LinUcbQgParams, LinearArms,
-};
+use hil_experiments::output::{Timing, write_outputs};
+use hil_experiments::results::aggregate;
+use hil_experiments::{NamedModel, Protocol, ProtocolSettings};
 
 /// The simulation workload models of the paper, by bundled name.
 pub const SIM_MODELS: [&str; 3] = ["f1_sim", "f2_sim", "f12_sim"];
@@ -35,19 +30,21 @@ pub struct ReproduceArgs {
     /// Master seed.
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Protocol settings file (TOML, every field of `ProtocolSettings`),
-    /// instead of the paper's (or --quick) settings.
+    /// Protocol settings file (TOML, every field of `ProtocolSettings`:
+    /// methods as policy configs, grids, seeds, split, figures; `plugins`
+    /// it lists are loaded first), instead of the paper's (or --quick) settings.
     #[arg(long)]
     pub settings: Option<PathBuf>,
     /// A food dataset directory instead of the bundled synthetic one.
     #[arg(long)]
     pub dataset: Option<PathBuf>,
-    /// UCB confidence weight α of the LinUCB family.
-    #[arg(long, default_value_t = DEFAULT_ALPHA)]
-    pub alpha: f64,
-    /// Ridge strength λ of the shared estimator.
-    #[arg(long, default_value_t = 1.0)]
-    pub lambda: f64,
+    /// Sets `alpha` (UCB confidence weight) in every method whose policy
+    /// config has one (the paper's methods: 0.5; the paper does not state it).
+    #[arg(long)]
+    pub alpha: Option<f64>,
+    /// Sets `lambda` (ridge strength) in every method whose policy config has one.
+    #[arg(long)]
+    pub lambda: Option<f64>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -56,9 +53,6 @@ pub struct ReproduceArgs {
     pub quiet: bool,
 }
 
-/// Default α (the paper does not state its value).
-pub const DEFAULT_ALPHA: f64 = 0.5;
-
 pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
     let t0 = Instant::now();
     let dataset: Arc<FoodDataset> = match &args.dataset {
@@ -66,15 +60,21 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         None => bundled_dataset()?,
     };
     let mut settings = match &args.settings {
-        Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| HilError::io("reading", p, e))?;
-            hil_core::config::parse_toml::<ProtocolSettings>(&text, p)?
-        }
+        Some(p) => ProtocolSettings::load(p)?,
         None if args.quick => ProtocolSettings::quick(),
         None => ProtocolSettings::paper(),
     };
     if let Some(s) = args.seed {
         settings.seed = s;
+    }
+    for (key, value) in [("alpha", args.alpha), ("lambda", args.lambda)] {
+        if let Some(v) = value {
+            for m in &mut settings.methods {
+                if m.policy.contains_key(key) {
+                    m.policy.insert(key.into(), toml::Value::Float(v));
+                }
+            }
+        }
     }
     let models = SIM_MODELS
         .iter()
@@ -86,48 +86,17 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         })
         .collect::<hil_core::Result<Vec<_>>>()?;
     settings.validate(&dataset, &models)?;
-
-    // Pretrain once; every run clones the estimator.
-    let pre = pretraining_data(
-        &dataset,
-        &settings.split.pretrain,
-        PretrainReward::Probability,
-        settings.seed,
-    )?;
-    let mut arms = LinearArms::new(dataset.actions.len(), dataset.context_dim, args.lambda)?;
-    arms.pretrain(&pre)?;
-    let alpha = args.alpha;
-    let kind = QueryKind::default();
-    let factory = move |spec: &PolicySpec| -> hil_core::Result<Box<dyn Policy>> {
-        Ok(match *spec {
-            PolicySpec::Linucb => Box::new(LinUcb::new(LinUcbParams::new(alpha)?, arms.clone())),
-            PolicySpec::AlwaysQuery => Box::new(AlwaysQuery::new(
-                AlwaysQueryParams::new(alpha, kind)?,
-                arms.clone(),
-            )),
-            PolicySpec::LinucbExpDecay { c } => Box::new(LinUcbExpDecay::new(
-                LinUcbExpDecayParams::new(alpha, c, kind)?,
-                arms.clone(),
-            )),
-            PolicySpec::LinucbQg { w } => Box::new(LinUcbQg::new(
-                LinUcbQgParams::new(alpha, w, kind)?,
-                arms.clone(),
-            )),
-        })
-    };
-    let setup_s = t0.elapsed().as_secs_f64();
-
-    let protocol = Protocol {
-        settings: settings.clone(),
-        dataset: dataset.clone(),
-        models: models.clone(),
-        factory: &factory,
-    };
+    let protocol = Protocol::new(settings.clone(), dataset.clone(), models.clone());
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
         .max(1);
-    let total = protocol.jobs().len();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| HilError::state("thread pool", e.to_string()))?;
+    let total = protocol.jobs()?.len();
+    let setup_s = t0.elapsed().as_secs_f64();
     let bar = if args.quiet {
         indicatif::ProgressBar::hidden()
     } else {
@@ -141,7 +110,7 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         b
     };
     let t1 = Instant::now();
-    let records = protocol.run_all(threads, &|done, _| bar.set_position(done as u64))?;
+    let records = pool.install(|| protocol.run_all(&|done, _| bar.set_position(done as u64)))?;
     bar.finish_and_clear();
     let runs_s = t1.elapsed().as_secs_f64();
 
@@ -153,24 +122,10 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         report_s: 0.0,
         threads,
     };
-    let plot_model = if models.iter().any(|m| m.name == "f2_sim") {
-        "f2_sim"
-    } else {
-        &models[0].name
-    };
-    let plot_w = if settings.w_tasks.iter().any(|w| (w - 0.7).abs() < 1e-9) {
-        0.7
-    } else {
-        settings.w_tasks[0]
-    };
     // Write once to measure, then again with the report time included.
-    write_outputs(
-        &args.out, &results, &records, &models, plot_model, plot_w, &timing,
-    )?;
+    write_outputs(&args.out, &results, &records, &models, &timing)?;
     timing.report_s = t2.elapsed().as_secs_f64();
-    let written = write_outputs(
-        &args.out, &results, &records, &models, plot_model, plot_w, &timing,
-    )?;
+    let written = write_outputs(&args.out, &results, &records, &models, &timing)?;
 
     if !args.quiet {
         eprintln!(
@@ -181,13 +136,14 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
             timing.report_s
         );
         eprintln!("data: {}", dataset.provenance);
+        let plot_w = settings.figure_w_task();
         println!("w_task = {plot_w} (test set; synthetic data, not the paper's results):");
         for m in &results.models {
-            for f in Family::ALL {
-                if let Some(r) = results.row(m, plot_w, f) {
+            for method in &settings.methods {
+                if let Some(r) = results.row(m, plot_w, &method.label) {
                     println!(
                         "  {m:<8} {:<16} r_task_avg {:.3} ± {:.3}  ΔWL {:+.3}  M_wt {:.3} ± {:.3}  f_q {:.3}{}",
-                        f.display(),
+                        method.label,
                         r.test.r_task_avg.mean,
                         r.test.r_task_avg.std,
                         r.test.delta_wl.mean,

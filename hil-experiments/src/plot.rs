@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use hil_core::{Result, WorkloadModel};
 
-use crate::protocol::RunRecord;
+use crate::testbed::RunRecord;
 
 const W: f64 = 760.0;
 const PANEL_H: f64 = 210.0;
@@ -125,7 +125,7 @@ impl Panel {
     }
 
     fn queries(&self, out: &mut String, run: &RunRecord, wl: &[f64]) {
-        for q in run.queries.records() {
+        for q in run.metrics.queries.records() {
             let y = wl.get(q.t as usize).copied().unwrap_or(0.0);
             let _ = writeln!(
                 out,
@@ -173,11 +173,10 @@ fn legend(out: &mut String, y: f64, entries: &[(&str, &str)]) {
 pub fn rollout_svg(
     run: &RunRecord,
     model: &dyn WorkloadModel,
-    wl0: f64,
     title: &str,
     note: &str,
 ) -> Result<String> {
-    let wl = run.workload_curve(model, wl0)?;
+    let wl = run.workload_curve(model)?;
     let gaps: Vec<(f64, f64)> = run
         .steps
         .iter()
@@ -196,7 +195,7 @@ pub fn rollout_svg(
     let (lo, hi) = ys.fold((0.0f64, 1.0f64), |(a, b), y| (a.min(y), b.max(y)));
     let p = Panel {
         x0: 0.0,
-        x1: run.t_final.max(1) as f64,
+        x1: run.metrics.t_final.max(1) as f64,
         y0: lo,
         y1: hi,
         top: TOP + 14.0,
@@ -241,18 +240,17 @@ pub fn rollout_svg(
 pub fn workload_comparison_svg(
     runs: &[(&str, &RunRecord)],
     model: &dyn WorkloadModel,
-    wl0: f64,
     note: &str,
 ) -> Result<String> {
     let x1 = runs
         .iter()
-        .map(|(_, r)| r.t_final)
+        .map(|(_, r)| r.metrics.t_final)
         .max()
         .unwrap_or(1)
         .max(1) as f64;
     let mut curves = Vec::new();
     for (_, r) in runs {
-        curves.push(r.workload_curve(model, wl0)?);
+        curves.push(r.workload_curve(model)?);
     }
     let (lo, hi) = curves
         .iter()
@@ -275,9 +273,9 @@ pub fn workload_comparison_svg(
         };
         let title = format!(
             "{label}: {} queries, T = {}, WL_T = {:.3}",
-            run.queries.len(),
-            run.t_final,
-            wl.last().copied().unwrap_or(wl0)
+            run.metrics.queries.len(),
+            run.metrics.t_final,
+            wl.last().copied().unwrap_or(run.metrics.wl0)
         );
         p.frame(&mut out, &title, "WL_t");
         p.item_starts(&mut out, run);

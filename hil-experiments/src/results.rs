@@ -5,7 +5,9 @@ use hil_core::metrics::mean_std;
 use hil_core::{HilError, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::protocol::{Family, NamedModel, Phase, PolicySpec, ProtocolSettings, RunRecord, Scored};
+use hil_core::EpisodeMetrics;
+
+use crate::testbed::{GridPoint, NamedModel, Phase, ProtocolSettings, RunRecord};
 
 /// Mean and (population) standard deviation over runs.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -26,10 +28,19 @@ impl Stat {
 /// A tuned hyperparameter and its value.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Hyperparameter {
-    /// `w` (LinUCB-QG) or `c` (LinUCB-ExpDecay).
+    /// Its name in the policy config (`w` for LinUCB-QG, `c` for LinUCB-ExpDecay).
     pub name: String,
     /// The chosen value.
     pub value: f64,
+}
+
+impl Hyperparameter {
+    fn of(point: &GridPoint) -> Option<Self> {
+        point.as_ref().map(|(name, value)| Self {
+            name: name.clone(),
+            value: *value,
+        })
+    }
 }
 
 /// Test metrics of one policy under one model and w_task.
@@ -54,17 +65,20 @@ pub struct MetricSummary {
 }
 
 impl MetricSummary {
-    fn of(scored: &[Scored]) -> Self {
-        let col = |f: fn(&Scored) -> f64| Stat::of(&scored.iter().map(f).collect::<Vec<_>>());
+    /// Summarises episodes scored at `w_task`.
+    pub fn of(scored: &[EpisodeMetrics], w_task: f64) -> Self {
+        let col = |f: &dyn Fn(&EpisodeMetrics) -> f64| {
+            Stat::of(&scored.iter().map(f).collect::<Vec<_>>())
+        };
         Self {
             n_runs: scored.len(),
-            r_task_avg: col(|s| s.r_task_avg),
-            delta_wl: col(|s| s.delta_wl),
-            m_wt: col(|s| s.m_wt),
-            t_conv: col(|s| s.t_conv),
-            f_q: col(|s| s.f_q),
-            f_fail_food: col(|s| s.f_fail_food),
-            f_auto_food: col(|s| s.f_auto_food),
+            r_task_avg: col(&|s| s.r_task_avg),
+            delta_wl: col(&|s| s.delta_wl),
+            m_wt: col(&|s| s.m_wt(w_task)),
+            t_conv: col(&|s| s.t_conv),
+            f_q: col(&|s| s.f_q),
+            f_fail_food: col(&|s| s.f_fail_food),
+            f_auto_food: col(&|s| s.f_auto_food),
         }
     }
 }
@@ -76,9 +90,9 @@ pub struct ResultRow {
     pub model: String,
     /// w_task.
     pub w_task: f64,
-    /// The policy.
-    pub policy: Family,
-    /// The hyperparameter chosen on validation, if the policy has one.
+    /// The method's label.
+    pub method: String,
+    /// The hyperparameter chosen on validation, if the method is tuned.
     pub selected: Option<Hyperparameter>,
     /// Test metrics.
     pub test: MetricSummary,
@@ -91,25 +105,27 @@ pub struct SelectionRow {
     pub model: String,
     /// w_task.
     pub w_task: f64,
-    /// Policy.
-    pub policy: Family,
+    /// The method's label.
+    pub method: String,
     /// (value, mean validation M_wt) per candidate, in grid order.
     pub candidates: Vec<(f64, f64)>,
     /// The chosen value (the first maximiser).
     pub chosen: f64,
 }
 
-/// LinUCB-QG deciding with one model and scored with another.
+/// A method deciding with one model and scored with another.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CrossRow {
+    /// The method's label.
+    pub method: String,
     /// Decision model.
     pub decide: String,
     /// Scoring model.
     pub score: String,
     /// w_task.
     pub w_task: f64,
-    /// w chosen on validation with the decision model.
-    pub selected: Hyperparameter,
+    /// The hyperparameter chosen on validation with the decision model.
+    pub selected: Option<Hyperparameter>,
     /// Test metrics scored with `score`.
     pub test: MetricSummary,
 }
@@ -134,11 +150,11 @@ pub struct ProtocolResults {
 }
 
 impl ProtocolResults {
-    /// The row for (model, w_task, policy), if computed.
-    pub fn row(&self, model: &str, w_task: f64, policy: Family) -> Option<&ResultRow> {
+    /// The row for (model, w_task, method label), if computed.
+    pub fn row(&self, model: &str, w_task: f64, method: &str) -> Option<&ResultRow> {
         self.rows
             .iter()
-            .find(|r| r.model == model && (r.w_task - w_task).abs() < 1e-9 && r.policy == policy)
+            .find(|r| r.model == model && (r.w_task - w_task).abs() < 1e-9 && r.method == method)
     }
 }
 
@@ -147,68 +163,68 @@ struct Index<'a> {
 }
 
 impl<'a> Index<'a> {
-    fn runs(&self, phase: Phase, spec: &PolicySpec, decide: Option<usize>) -> Vec<&'a RunRecord> {
+    fn runs(&self, phase: Phase, method: usize, cand: &Candidate) -> Vec<&'a RunRecord> {
         self.records
             .iter()
-            .filter(|r| r.key.phase == phase && r.key.spec == *spec && r.key.decide_model == decide)
+            .filter(|r| {
+                r.key.phase == phase
+                    && r.key.method == method
+                    && r.key.point == cand.0
+                    && r.key.decide_model == cand.1
+            })
             .collect()
     }
 }
 
-fn score_all(
-    runs: &[&RunRecord],
-    model: &NamedModel,
-    wl0: f64,
-    w_task: f64,
-) -> Result<Vec<Scored>> {
+/// Every run scored under `model` (hil-core's definition, rescored).
+fn score_all(runs: &[&RunRecord], model: &NamedModel) -> Result<Vec<EpisodeMetrics>> {
     runs.iter()
-        .map(|r| r.score(model.model.as_ref(), wl0, w_task))
+        .map(|r| r.metrics.rescored(model.model.as_ref()))
         .collect()
 }
 
-/// A policy spec with the index of the model it decides with (QG only).
-type Candidate = (PolicySpec, Option<usize>);
+/// A grid point with the index of the model the method decides with.
+type Candidate = (GridPoint, Option<usize>);
 
-/// Candidates of `family` when the decision model is `m`.
-fn candidates(s: &ProtocolSettings, family: Family, m: usize) -> Vec<Candidate> {
-    match family {
-        Family::Linucb => vec![(PolicySpec::Linucb, None)],
-        Family::AlwaysQuery => vec![(PolicySpec::AlwaysQuery, None)],
-        Family::LinucbExpDecay => s
-            .exp_decay_c
-            .iter()
-            .map(|&c| (PolicySpec::LinucbExpDecay { c }, None))
-            .collect(),
-        Family::LinucbQg => s
-            .qg_w
-            .iter()
-            .map(|&w| (PolicySpec::LinucbQg { w }, Some(m)))
-            .collect(),
-    }
+/// Candidates of method `i` when the decision model is `m`: one per grid
+/// point, deciding with `m` if the method has runs per deciding model.
+fn candidates(idx: &Index<'_>, s: &ProtocolSettings, i: usize, m: usize) -> Vec<Candidate> {
+    s.methods[i]
+        .grid()
+        .into_iter()
+        .map(|point| {
+            let per_model = idx
+                .records
+                .iter()
+                .any(|r| r.key.method == i && r.key.point == point && r.key.decide_model.is_some());
+            (point, per_model.then_some(m))
+        })
+        .collect()
 }
 
-/// Chooses, by mean validation M_wt under `models[m]`, among `family`'s candidates.
+/// Chooses, by mean validation M_wt under `models[m]`, among method `i`'s
+/// candidates.
 fn select(
     s: &ProtocolSettings,
     idx: &Index<'_>,
     models: &[NamedModel],
     m: usize,
-    family: Family,
+    i: usize,
     w_task: f64,
 ) -> Result<(Candidate, Vec<(f64, f64)>)> {
     let mut best: Option<(Candidate, f64)> = None;
     let mut table = Vec::new();
-    for cand in candidates(s, family, m) {
-        let runs = idx.runs(Phase::Validation, &cand.0, cand.1);
+    for cand in candidates(idx, s, i, m) {
+        let runs = idx.runs(Phase::Validation, i, &cand);
         if runs.is_empty() {
             return Err(HilError::state(
                 "protocol",
-                format!("no validation runs of {:?}", cand.0),
+                format!("no validation runs of `{}` {:?}", s.methods[i].label, cand.0),
             ));
         }
-        let scored = score_all(&runs, &models[m], s.session.wl0, w_task)?;
-        let mean = scored.iter().map(|x| x.m_wt).sum::<f64>() / scored.len() as f64;
-        table.push((cand.0.hyperparameter().map_or(0.0, |h| h.1), mean));
+        let scored = score_all(&runs, &models[m])?;
+        let mean = scored.iter().map(|x| x.m_wt(w_task)).sum::<f64>() / scored.len() as f64;
+        table.push((cand.0.as_ref().map_or(0.0, |h| h.1), mean));
         if best.as_ref().is_none_or(|(_, b)| mean > *b) {
             best = Some((cand, mean));
         }
@@ -225,24 +241,20 @@ pub fn aggregate(
     provenance: &str,
 ) -> Result<ProtocolResults> {
     let idx = Index { records };
-    let wl0 = settings.session.wl0;
     let mut rows = Vec::new();
     let mut selection = Vec::new();
     for (m, model) in models.iter().enumerate() {
         for &w_task in &settings.w_tasks {
-            for family in Family::ALL {
-                let ((spec, decide), table) = select(settings, &idx, models, m, family, w_task)?;
-                let runs = idx.runs(Phase::Test, &spec, decide);
-                let test = MetricSummary::of(&score_all(&runs, model, wl0, w_task)?);
-                let selected = spec.hyperparameter().map(|(n, v)| Hyperparameter {
-                    name: n.into(),
-                    value: v,
-                });
+            for (i, method) in settings.methods.iter().enumerate() {
+                let (cand, table) = select(settings, &idx, models, m, i, w_task)?;
+                let runs = idx.runs(Phase::Test, i, &cand);
+                let test = MetricSummary::of(&score_all(&runs, model)?, w_task);
+                let selected = Hyperparameter::of(&cand.0);
                 if let Some(h) = &selected {
                     selection.push(SelectionRow {
                         model: model.name.clone(),
                         w_task,
-                        policy: family,
+                        method: method.label.clone(),
                         candidates: table,
                         chosen: h.value,
                     });
@@ -250,7 +262,7 @@ pub fn aggregate(
                 rows.push(ResultRow {
                     model: model.name.clone(),
                     w_task,
-                    policy: family,
+                    method: method.label.clone(),
                     selected,
                     test,
                 });
@@ -266,19 +278,23 @@ pub fn aggregate(
                 .ok_or_else(|| HilError::invalid_parameter("cross", n, "unknown workload model"))
         };
         let (d, sc) = (find(&c.decide)?, find(&c.score)?);
+        let i = settings
+            .methods
+            .iter()
+            .position(|m| m.label == c.method)
+            .ok_or_else(|| {
+                HilError::invalid_parameter("cross.method", &c.method, "no method has that label")
+            })?;
         let w_task = settings.cross_w_task;
-        let ((spec, decide), _) = select(settings, &idx, models, d, Family::LinucbQg, w_task)?;
-        let runs = idx.runs(Phase::Test, &spec, decide);
-        let test = MetricSummary::of(&score_all(&runs, &models[sc], wl0, w_task)?);
-        let (n, v) = spec.hyperparameter().expect("QG has w");
+        let (cand, _) = select(settings, &idx, models, d, i, w_task)?;
+        let runs = idx.runs(Phase::Test, i, &cand);
+        let test = MetricSummary::of(&score_all(&runs, &models[sc])?, w_task);
         cross.push(CrossRow {
+            method: c.method.clone(),
             decide: c.decide.clone(),
             score: c.score.clone(),
             w_task,
-            selected: Hyperparameter {
-                name: n.into(),
-                value: v,
-            },
+            selected: Hyperparameter::of(&cand.0),
             test,
         });
     }

@@ -3,8 +3,9 @@
 
 use std::fmt::Write as _;
 
-use crate::protocol::Family;
-use crate::published;
+use hil_core::Result;
+
+use crate::published::{self, PublishedRow};
 use crate::results::{MetricSummary, ProtocolResults, Stat};
 
 fn pm(s: Stat) -> String {
@@ -17,6 +18,11 @@ fn ppm(m: f64, s: f64) -> String {
 
 fn opt(v: Option<String>) -> String {
     v.unwrap_or_else(|| "—".into())
+}
+
+/// The published `figure` of `row` as "mean ± std", if the paper has it.
+fn paper(row: Option<&PublishedRow>, figure: &str) -> Option<String> {
+    row.and_then(|r| r.get(figure)).map(|(m, s)| ppm(m, s))
 }
 
 /// Paper names of the models.
@@ -36,8 +42,19 @@ fn hyper(r: &crate::results::ResultRow) -> String {
 }
 
 /// Renders the whole report.
-pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> String {
+pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<String> {
     let s = &res.settings;
+    let published = published::tables()?;
+    let labels: Vec<&str> = s.methods.iter().map(|m| m.label.as_str()).collect();
+    let grids: Vec<String> = s
+        .methods
+        .iter()
+        .flat_map(|m| {
+            m.tune
+                .iter()
+                .map(move |(n, v)| format!("{n} ∈ {v:?} ({})", m.label))
+        })
+        .collect();
     let mut o = String::new();
     let _ = writeln!(o, "# Simulated testbed: our results beside the paper's\n");
     let _ = writeln!(
@@ -47,7 +64,7 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> String 
     );
     let _ = writeln!(
         o,
-        "Protocol: pretrain on {} foods; validation {}; test {}; {} items per episode; N_att = {}; WL_0 = {}; {} seeds ({} policy seeds for LinUCB-ExpDecay); master seed {}; grids w ∈ {:?} (LinUCB-QG), c ∈ {:?} (LinUCB-ExpDecay), chosen per (model, w_task) by mean validation M_wt. {} episodes{}.\n",
+        "Protocol: pretrain on {} foods; validation {}; test {}; {} items per episode; N_att = {}; WL_0 = {}; {} seeds ({} policy seeds for stochastic methods); master seed {}; grids {}, chosen per (model, w_task) by mean validation M_wt. {} episodes{}.\n",
         s.split.pretrain.len(),
         s.split.validation.join(", "),
         s.split.test.join(", "),
@@ -57,8 +74,11 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> String 
         s.n_seeds,
         s.n_policy_seeds,
         s.seed,
-        s.qg_w,
-        s.exp_decay_c,
+        if grids.is_empty() {
+            "none".to_string()
+        } else {
+            grids.join(", ")
+        },
         res.n_episodes,
         elapsed_s.map_or(String::new(), |t| format!(" in {t:.1} s"))
     );
@@ -77,54 +97,50 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> String 
         );
         let _ = writeln!(o, "|---|---|---|---|---|---|---|---|---|");
         for m in &res.models {
-            for f in Family::ALL {
+            for f in &labels {
                 if let Some(r) = res.row(m, w_main, f) {
-                    let p = published::by_w_task(m, w_main, f);
+                    let p = published.by_w_task(m, w_main, f);
                     let _ = writeln!(
                         o,
                         "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                         model_title(m),
-                        f.display(),
+                        f,
                         pm(r.test.r_task_avg),
-                        opt(p.map(|v| ppm(v[0], v[1]))),
+                        opt(paper(p, "r_task_avg")),
                         pm(r.test.m_wt),
-                        opt(p.map(|v| ppm(v[2], v[3]))),
+                        opt(paper(p, "m_wt")),
                         pm(r.test.f_q),
-                        opt(p.map(|v| ppm(v[4], v[5]))),
+                        opt(paper(p, "f_q")),
                         hyper(r)
                     );
                 }
             }
         }
         let _ = writeln!(o);
-        let _ = writeln!(
-            o,
-            "## Convergence metrics — test set, w_task = {}\n",
-            published::CONVERGENCE_W_TASK
-        );
+        let _ = writeln!(o, "## Convergence metrics — test set, w_task = {w_main}\n");
         let _ = writeln!(
             o,
             "| Workload model | Method | ΔWL (ours) | ΔWL (paper) | t_conv (ours) | t_conv (paper) | f_fail,food (ours) | f_fail,food (paper) | f_auto,food (ours) | f_auto,food (paper) |"
         );
         let _ = writeln!(o, "|---|---|---|---|---|---|---|---|---|---|");
         for m in &res.models {
-            for f in Family::ALL {
-                if let Some(r) = res.row(m, published::CONVERGENCE_W_TASK, f) {
-                    let p = published::convergence(m, f);
+            for f in &labels {
+                if let Some(r) = res.row(m, w_main, f) {
+                    let p = published.convergence(m, w_main, f);
                     let t = &r.test;
                     let _ = writeln!(
                         o,
                         "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                         model_title(m),
-                        f.display(),
+                        f,
                         pm(t.delta_wl),
-                        opt(p.map(|v| ppm(v[0], v[1]))),
+                        opt(paper(p, "delta_wl")),
                         pm(t.t_conv),
-                        opt(p.map(|v| ppm(v[2], v[3]))),
+                        opt(paper(p, "t_conv")),
                         pm(t.f_fail_food),
-                        opt(p.map(|v| ppm(v[4], v[5]))),
+                        opt(paper(p, "f_fail_food")),
                         pm(t.f_auto_food),
-                        opt(p.map(|v| ppm(v[6], v[7]))),
+                        opt(paper(p, "f_auto_food")),
                     );
                 }
             }
@@ -149,31 +165,31 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> String 
         );
         let _ = writeln!(o, "|---|---|---|---|---|---|---|---|---|");
         for &w in &s.w_tasks {
-            let ours: Vec<_> = Family::ALL
-                .iter()
-                .filter_map(|f| res.row(m, w, *f))
-                .collect();
+            let ours: Vec<_> = labels.iter().filter_map(|f| res.row(m, w, f)).collect();
             let best_ours = ours
                 .iter()
                 .map(|r| r.test.m_wt.mean)
                 .fold(f64::NEG_INFINITY, f64::max);
-            let best_paper = Family::ALL
+            let best_paper = labels
                 .iter()
-                .filter_map(|f| published::by_w_task(m, w, *f).map(|v| v[2]))
+                .filter_map(|f| published.by_w_task(m, w, f).and_then(|r| r.get("m_wt")))
+                .map(|v| v.0)
                 .fold(f64::NEG_INFINITY, f64::max);
             for r in ours {
-                let p = published::by_w_task(m, w, r.policy);
+                let p = published.by_w_task(m, w, &r.method);
                 let bold = |s: String, b: bool| if b { format!("**{s}**") } else { s };
                 let _ = writeln!(
                     o,
                     "| {w:.1} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                    r.policy.display(),
+                    r.method,
                     pm(r.test.r_task_avg),
-                    opt(p.map(|v| ppm(v[0], v[1]))),
+                    opt(paper(p, "r_task_avg")),
                     bold(pm(r.test.m_wt), r.test.m_wt.mean == best_ours),
-                    opt(p.map(|v| bold(ppm(v[2], v[3]), v[2] == best_paper))),
+                    opt(p
+                        .and_then(|p| p.get("m_wt"))
+                        .map(|v| bold(ppm(v.0, v.1), v.0 == best_paper))),
                     pm(r.test.f_q),
-                    opt(p.map(|v| ppm(v[4], v[5]))),
+                    opt(paper(p, "f_q")),
                     hyper(r)
                 );
             }
@@ -185,7 +201,7 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> String 
     if !res.cross.is_empty() {
         let _ = writeln!(
             o,
-            "## Cross-data: LinUCB-QG deciding with one model, scored with another (test set, w_task = {})\n",
+            "## Cross-data: a method deciding with one model, scored with another (test set, w_task = {})\n",
             s.cross_w_task
         );
         let mut head = "| Metric |".to_string();
@@ -193,38 +209,36 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> String 
         for c in &res.cross {
             let _ = write!(
                 head,
-                " {d}-on-{s} (ours) | {d}-on-{s} (paper) |",
+                " {m} {d}-on-{s} (ours) | {m} {d}-on-{s} (paper) |",
+                m = c.method,
                 d = c.decide,
                 s = c.score
             );
             rule.push_str("---|---|");
         }
         let _ = writeln!(o, "{head}\n{rule}");
-        let metric = |name: &str, get: &dyn Fn(&MetricSummary) -> Stat, k: usize| {
+        let metric = |name: &str, get: &dyn Fn(&MetricSummary) -> Stat, figure: &str| {
             let mut line = format!("| {name} |");
             for c in &res.cross {
-                let p = if (s.cross_w_task - published::CROSS_W_TASK).abs() < 1e-9 {
-                    published::cross(&c.decide, &c.score)
-                } else {
-                    None
-                };
-                let _ = write!(
-                    line,
-                    " {} | {} |",
-                    pm(get(&c.test)),
-                    opt(p.map(|v| ppm(v[2 * k], v[2 * k + 1])))
-                );
+                let p = published.cross(&c.decide, &c.score, s.cross_w_task, &c.method);
+                let _ = write!(line, " {} | {} |", pm(get(&c.test)), opt(paper(p, figure)));
             }
             line
         };
-        let _ = writeln!(o, "{}", metric("r_task,avg", &|t| t.r_task_avg, 0));
-        let _ = writeln!(o, "{}", metric("ΔWL", &|t| t.delta_wl, 1));
-        let _ = writeln!(o, "{}", metric("M_wt", &|t| t.m_wt, 2));
-        let _ = writeln!(o, "{}", metric("f_q", &|t| t.f_q, 3));
+        let _ = writeln!(o, "{}", metric("r_task,avg", &|t| t.r_task_avg, "r_task_avg"));
+        let _ = writeln!(o, "{}", metric("ΔWL", &|t| t.delta_wl, "delta_wl"));
+        let _ = writeln!(o, "{}", metric("M_wt", &|t| t.m_wt, "m_wt"));
+        let _ = writeln!(o, "{}", metric("f_q", &|t| t.f_q, "f_q"));
         let chosen: Vec<String> = res
             .cross
             .iter()
-            .map(|c| format!("{}-on-{}: w = {}", c.decide, c.score, c.selected.value))
+            .map(|c| {
+                let h = c
+                    .selected
+                    .as_ref()
+                    .map_or("untuned".into(), |h| format!("{} = {}", h.name, h.value));
+                format!("{}-on-{}: {h}", c.decide, c.score)
+            })
             .collect();
         let _ = writeln!(
             o,
@@ -232,5 +246,5 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> String 
             chosen.join("; ")
         );
     }
-    o
+    Ok(o)
 }

@@ -1,0 +1,131 @@
+//! Writes a protocol run's outputs: `results.json`, `tables.md` and the SVG
+//! figures.
+
+use std::path::{Path, PathBuf};
+
+use hil_core::{HilError, Result};
+use serde::Serialize;
+
+use crate::plot::{rollout_svg, workload_comparison_svg};
+use crate::report::tables_markdown;
+use crate::testbed::{NamedModel, Phase, RunRecord};
+use crate::results::ProtocolResults;
+
+/// Where the time went.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Timing {
+    /// Building the dataset, models and pretrained estimator.
+    pub setup_s: f64,
+    /// Running every episode.
+    pub runs_s: f64,
+    /// Selection, aggregation and writing files.
+    pub report_s: f64,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+#[derive(Serialize)]
+struct ResultsFile<'a> {
+    #[serde(flatten)]
+    results: &'a ProtocolResults,
+    timing: &'a Timing,
+    delta_wl_definition: &'static str,
+}
+
+/// The files written.
+#[derive(Clone, Debug)]
+pub struct Written {
+    /// `results.json`.
+    pub results: PathBuf,
+    /// `tables.md`.
+    pub tables: PathBuf,
+    /// SVG figures.
+    pub figures: Vec<PathBuf>,
+}
+
+fn write(path: &Path, text: &str) -> Result<()> {
+    std::fs::write(path, text).map_err(|e| HilError::io("writing", path, e))
+}
+
+/// Writes `results.json`, `tables.md`, `rollout.svg` and `workload.svg`
+/// into `dir`. The figures follow the settings' [`FigureSettings`]
+/// (the paper's: LinUCB-QG's gap and threshold, and the workload curves of
+/// the querying methods under the D2 model at w_task = 0.7), with each
+/// method's hyperparameter as chosen for that model and w_task, on test
+/// episode 0. A figure model or w_task the run does not have falls back to
+/// the first model or w_task.
+///
+/// [`FigureSettings`]: crate::testbed::FigureSettings
+pub fn write_outputs(
+    dir: &Path,
+    results: &ProtocolResults,
+    records: &[RunRecord],
+    models: &[NamedModel],
+    timing: &Timing,
+) -> Result<Written> {
+    std::fs::create_dir_all(dir).map_err(|e| HilError::io("creating", dir, e))?;
+    let results_path = dir.join("results.json");
+    let json = serde_json::to_string_pretty(&ResultsFile {
+        results,
+        timing,
+        delta_wl_definition: "paper: f(WL_0, Q_T) - WL_0 with the workload model evaluated at the final timestep T over the episode's query history (hil_core::EpisodeMetrics)",
+    })
+    .map_err(|e| HilError::serde("results", e))?;
+    write(&results_path, &json)?;
+    let tables = dir.join("tables.md");
+    write(
+        &tables,
+        &tables_markdown(results, Some(timing.runs_s + timing.setup_s))?,
+    )?;
+
+    let s = &results.settings;
+    let fig = &s.figures;
+    let m = models.iter().position(|x| x.name == fig.model).unwrap_or(0);
+    let plot_model = &models[m].name;
+    let plot_w = s.figure_w_task();
+    let model = models[m].model.as_ref();
+    // Test episode 0 of `label` with its hyperparameter as chosen for the
+    // figure's model and w_task.
+    let run_of = |label: &str| -> Option<(&RunRecord, String)> {
+        let i = s.methods.iter().position(|x| x.label == label)?;
+        let row = results.row(plot_model, plot_w, label)?;
+        let point = row.selected.as_ref().map(|h| (h.name.clone(), h.value));
+        let run = records.iter().find(|r| {
+            r.key.phase == Phase::Test
+                && r.key.seed == 0
+                && r.key.policy_seed == 0
+                && r.key.method == i
+                && r.key.point == point
+                && r.key.decide_model.is_none_or(|d| d == m)
+        })?;
+        let title = match &row.selected {
+            Some(h) => format!("{label} ({} = {})", h.name, h.value),
+            None => label.to_string(),
+        };
+        Some((run, title))
+    };
+    let note = format!(
+        "Synthetic data and workload model ({plot_model}), not the paper's; test episode 0."
+    );
+    let mut figures = Vec::new();
+    if let Some((run, title)) = run_of(&fig.rollout) {
+        let p = dir.join("rollout.svg");
+        let title = format!("{title} rollout ({plot_model}, w_task = {plot_w})");
+        write(&p, &rollout_svg(run, model, &title, &note)?)?;
+        figures.push(p);
+    }
+    let compared: Vec<(&RunRecord, String)> =
+        fig.workload.iter().filter_map(|l| run_of(l)).collect();
+    if !compared.is_empty() {
+        let p = dir.join("workload.svg");
+        let runs: Vec<(&str, &RunRecord)> =
+            compared.iter().map(|(r, t)| (t.as_str(), *r)).collect();
+        write(&p, &workload_comparison_svg(&runs, model, &note)?)?;
+        figures.push(p);
+    }
+    Ok(Written {
+        results: results_path,
+        tables,
+        figures,
+    })
+}

@@ -1,0 +1,659 @@
+//! The paper's simulated-testbed protocol.
+//!
+//! 1. Split the foods (pretrain / validation / test, [`FoodSplit`]). Every
+//!    policy is built through its [`PolicyConfig`] with a [`BuildContext`]
+//!    that offers the pretraining foods' (context, arm, reward) data, so a
+//!    config with `pretrain = true` starts from the pretrained estimator.
+//! 2. Run every (phase, method, grid value, seed[, policy seed][, deciding
+//!    workload model]) episode once, in parallel. What a method needs comes
+//!    from its config: one that does not read the workload forecast
+//!    ([`PolicyConfig::uses_workload_forecast`]) runs once and is scored under
+//!    every model; one that does runs once per deciding model; a stochastic
+//!    one ([`PolicyConfig::is_stochastic`]) runs under `n_policy_seeds`
+//!    policy seeds. w_task never changes a run, only how it is scored.
+//! 3. For every scoring model and w_task, choose each tuned method's
+//!    hyperparameter maximising the mean M_wt over the validation runs,
+//!    then report the test metrics of that choice.
+//! 4. Cross-data: a method deciding with one model and scored with another
+//!    ([`EpisodeMetrics::rescored`]), its hyperparameter chosen on
+//!    validation with the deciding model (as the paper's numbers show: its
+//!    cross-data r_task and f_q equal the same-model rows).
+//!
+//! Scoring is hil-core's, the paper's: ΔWL = f(WL_0, Q_T) − WL_0 at the
+//! episode's final timestep ([`EpisodeMetrics`]); nothing here recomputes it.
+//!
+//! Methods are ordinary policy configs, built-in or plugin types:
+//!
+//! ```toml
+//! [[methods]]
+//! label = "LinUCB-QG"
+//! policy = { type = "linucb_qg", alpha = 0.5, lambda = 1.0, pretrain = true, w = 1.0 }
+//! tune = { w = [0.25, 0.5, 1.0, 2.0] }   # at most one tuned hyperparameter
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use hil_core::config::{BuildContext, PolicyConfig};
+use hil_core::session::{ComponentSeeds, splitmix};
+use hil_core::{
+    EpisodeMetrics, HilError, QueryChannel, Result, Session, SessionSettings, StepDecision,
+    Timestep, WorkloadModel,
+};
+use hil_envs::env::{PretrainReward, pretraining_data};
+use hil_envs::{DatasetReplayEnv, FoodDataset, FoodSplit};
+use rayon::prelude::*;
+use serde::{Deserialize, Deserializer, Serialize};
+
+/// A method of the protocol: a policy config (any registered or plugin
+/// type), the label it is reported under, and at most one hyperparameter
+/// tuned over a grid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Method {
+    /// The name tables print (e.g. `LinUCB-QG`); unique in a protocol.
+    pub label: String,
+    /// The policy table, as in an experiment file (`type = "..."` and the
+    /// type's parameters). Checked to build a policy config when parsed.
+    #[serde(deserialize_with = "policy_table")]
+    pub policy: toml::Table,
+    /// The tuned hyperparameter and its grid, e.g. `{ w = [0.5, 4.0] }`;
+    /// chosen on validation per (workload model, w_task). Empty: untuned.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub tune: BTreeMap<String, Vec<f64>>,
+}
+
+/// Deserialises a policy table and checks that it names a policy config
+/// (built-in or from a loaded plugin) with valid fields.
+fn policy_table<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<toml::Table, D::Error> {
+    use serde::de::Error as _;
+    let table = toml::Table::deserialize(d)?;
+    policy_config(&table).map_err(D::Error::custom)?;
+    Ok(table)
+}
+
+/// The policy config a table describes.
+fn policy_config(table: &toml::Table) -> std::result::Result<Box<dyn PolicyConfig>, String> {
+    hil_core::plugin::component::<_, dyn PolicyConfig>(toml::Value::Table(table.clone()))
+        .map_err(|e: toml::de::Error| e.message().trim().to_string())
+}
+
+/// One point of a method's grid.
+pub type GridPoint = Option<(String, f64)>;
+
+impl Method {
+    /// A method from a policy table literal (built-in types must be linked).
+    pub fn new(label: &str, policy: toml::Table) -> Self {
+        Self {
+            label: label.into(),
+            policy,
+            tune: BTreeMap::new(),
+        }
+    }
+
+    /// The same method with `name` tuned over `values`.
+    pub fn tuned(mut self, name: &str, values: &[f64]) -> Self {
+        self.tune = BTreeMap::from([(name.to_string(), values.to_vec())]);
+        self
+    }
+
+    /// The grid points: `None` for an untuned method, else one per value.
+    pub fn grid(&self) -> Vec<GridPoint> {
+        match self.tune.iter().next() {
+            None => vec![None],
+            Some((name, values)) => values.iter().map(|v| Some((name.clone(), *v))).collect(),
+        }
+    }
+
+    /// The policy config at grid point `point`.
+    pub fn config(&self, point: &GridPoint) -> Result<Box<dyn PolicyConfig>> {
+        let mut table = self.policy.clone();
+        if let Some((name, value)) = point {
+            table.insert(name.clone(), toml::Value::Float(*value));
+        }
+        policy_config(&table).map_err(|why| {
+            HilError::invalid_parameter(format!("methods.{}.policy", self.label), "table", why)
+        })
+    }
+}
+
+/// A cross-data setting: a method deciding with one model, scored with another.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrossSetting {
+    /// The label of the method (it must read the workload forecast).
+    pub method: String,
+    /// The model the method decides with.
+    pub decide: String,
+    /// The model ΔWL and M_wt are computed with.
+    pub score: String,
+}
+
+/// Which runs the report's figures show.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FigureSettings {
+    /// The workload model the figures use (the first model if absent).
+    pub model: String,
+    /// The w_task whose chosen hyperparameters the figures use (the first
+    /// w_task if absent).
+    pub w_task: f64,
+    /// The method whose gap and threshold are plotted over one episode.
+    pub rollout: String,
+    /// The methods whose workload curves are compared.
+    pub workload: Vec<String>,
+}
+
+/// Everything that defines a protocol run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProtocolSettings {
+    /// Plugin libraries to load before the methods are parsed (relative to
+    /// the settings file), so methods may name plugin policy types.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plugins: Vec<PathBuf>,
+    /// Food split.
+    pub split: FoodSplit,
+    /// N_att and WL_0.
+    pub session: SessionSettings,
+    /// Items per episode.
+    pub items_per_episode: usize,
+    /// Master seed; environment and policy seeds derive from it.
+    pub seed: u64,
+    /// Number of environment seeds (episodes per configuration).
+    pub n_seeds: usize,
+    /// Policy seeds for stochastic methods.
+    pub n_policy_seeds: usize,
+    /// The w_task values scored.
+    pub w_tasks: Vec<f64>,
+    /// The methods, in table order.
+    pub methods: Vec<Method>,
+    /// Cross-data settings.
+    #[serde(default)]
+    pub cross: Vec<CrossSetting>,
+    /// w_task of the cross-data experiment.
+    pub cross_w_task: f64,
+    /// What the figures show.
+    pub figures: FigureSettings,
+}
+
+/// The paper's policy table for `ty`: α = 0.5 (the paper does not state
+/// it), λ = 1, pretrained on the pretraining foods.
+fn paper_policy(ty: &str, extra: &[(&str, f64)]) -> toml::Table {
+    let mut t = toml::Table::new();
+    t.insert("type".into(), toml::Value::String(ty.into()));
+    t.insert("alpha".into(), toml::Value::Float(0.5));
+    t.insert("lambda".into(), toml::Value::Float(1.0));
+    t.insert("pretrain".into(), toml::Value::Boolean(true));
+    for (k, v) in extra {
+        t.insert((*k).into(), toml::Value::Float(*v));
+    }
+    t
+}
+
+impl ProtocolSettings {
+    /// The paper's protocol: 3 seeds, 5 policy seeds, N_att = 10,
+    /// WL_0 = 0.5, 5 items per episode, w_task ∈ {0.2, …, 0.9}, the four
+    /// methods, f1-on-f2 and f12-on-f2 at w_task = 0.4. The w and c grids
+    /// are ours (the paper does not list them).
+    pub fn paper() -> Self {
+        let cross = |decide: &str| CrossSetting {
+            method: "LinUCB-QG".into(),
+            decide: decide.into(),
+            score: "f2_sim".into(),
+        };
+        Self {
+            plugins: Vec::new(),
+            split: FoodSplit::paper(),
+            session: SessionSettings::default(),
+            items_per_episode: 5,
+            seed: 0,
+            n_seeds: 3,
+            n_policy_seeds: 5,
+            w_tasks: (2..=9).map(|k| k as f64 / 10.0).collect(),
+            methods: vec![
+                Method::new("LinUCB", paper_policy("linucb", &[])),
+                Method::new("AlwaysQuery", paper_policy("always_query", &[])),
+                Method::new(
+                    "LinUCB-ExpDecay",
+                    paper_policy("linucb_exp_decay", &[("c", 0.0)]),
+                )
+                .tuned("c", &[0.0, 0.1, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0]),
+                Method::new("LinUCB-QG", paper_policy("linucb_qg", &[("w", 1.0)]))
+                    .tuned("w", &[0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0]),
+            ],
+            cross: vec![cross("f1_sim"), cross("f12_sim")],
+            cross_w_task: 0.4,
+            figures: FigureSettings {
+                model: "f2_sim".into(),
+                w_task: 0.7,
+                rollout: "LinUCB-QG".into(),
+                workload: vec![
+                    "AlwaysQuery".into(),
+                    "LinUCB-ExpDecay".into(),
+                    "LinUCB-QG".into(),
+                ],
+            },
+        }
+    }
+
+    /// A fast smoke version: 3-point grids, 2 policy seeds.
+    pub fn quick() -> Self {
+        let mut s = Self::paper();
+        s.n_policy_seeds = 2;
+        for m in &mut s.methods {
+            for (name, values) in m.tune.iter_mut() {
+                *values = match name.as_str() {
+                    "c" => vec![0.0, 0.5, 4.0],
+                    _ => vec![0.5, 4.0, 32.0],
+                };
+            }
+        }
+        s
+    }
+
+    /// Reads settings from a TOML file; errors name file, line and field.
+    /// The `plugins = [...]` the file lists are loaded first, so methods may
+    /// name plugin policy types.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
+        hil_core::config::load_plugins(&text, path)?;
+        Ok(hil_core::config::parse_toml(&text, path)?)
+    }
+
+    /// Checks the settings against a dataset and the available models.
+    pub fn validate(&self, ds: &FoodDataset, models: &[NamedModel]) -> Result<()> {
+        self.split.validate(ds)?;
+        self.session.validate()?;
+        let positive = |name: &str, v: usize| {
+            if v == 0 {
+                Err(HilError::invalid_parameter(name, 0, "must be at least 1"))
+            } else {
+                Ok(())
+            }
+        };
+        positive("items_per_episode", self.items_per_episode)?;
+        positive("n_seeds", self.n_seeds)?;
+        positive("n_policy_seeds", self.n_policy_seeds)?;
+        if self.w_tasks.is_empty() || self.w_tasks.iter().any(|w| !(0.0..=1.0).contains(w)) {
+            return Err(HilError::invalid_parameter(
+                "w_tasks",
+                format!("{:?}", self.w_tasks),
+                "needs at least one value, each in [0, 1]",
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.cross_w_task) {
+            return Err(HilError::invalid_parameter(
+                "cross_w_task",
+                self.cross_w_task,
+                "must be in [0, 1]",
+            ));
+        }
+        if self.methods.is_empty() {
+            return Err(HilError::invalid_parameter(
+                "methods",
+                "[]",
+                "needs at least one method",
+            ));
+        }
+        for (i, m) in self.methods.iter().enumerate() {
+            if self.methods[..i].iter().any(|o| o.label == m.label) {
+                return Err(HilError::invalid_parameter(
+                    format!("methods[{i}].label"),
+                    &m.label,
+                    "labels must be unique",
+                ));
+            }
+            if m.tune.len() > 1 {
+                return Err(HilError::invalid_parameter(
+                    format!("methods[{i}].tune"),
+                    m.tune.keys().cloned().collect::<Vec<_>>().join(", "),
+                    "at most one hyperparameter can be tuned per method",
+                ));
+            }
+            for (name, values) in &m.tune {
+                if values.is_empty() || values.iter().any(|x| !x.is_finite()) {
+                    return Err(HilError::invalid_parameter(
+                        format!("methods[{i}].tune.{name}"),
+                        format!("{values:?}"),
+                        "needs at least one value, each finite",
+                    ));
+                }
+            }
+            for point in m.grid() {
+                m.config(&point)?;
+            }
+        }
+        if models.is_empty() {
+            return Err(HilError::invalid_input("workload models", "none given"));
+        }
+        for c in &self.cross {
+            let m = self.method(&c.method).ok_or_else(|| {
+                HilError::invalid_parameter("cross.method", &c.method, "no method has that label")
+            })?;
+            if !m.config(&m.grid()[0])?.uses_workload_forecast() {
+                return Err(HilError::invalid_parameter(
+                    "cross.method",
+                    &c.method,
+                    "the method does not read the workload forecast, so deciding with \
+                     another model changes nothing",
+                ));
+            }
+            for n in [&c.decide, &c.score] {
+                if !models.iter().any(|m| &m.name == n) {
+                    return Err(HilError::invalid_parameter(
+                        "cross",
+                        n,
+                        "no workload model of that name is in the protocol",
+                    ));
+                }
+            }
+        }
+        for label in std::iter::once(&self.figures.rollout).chain(&self.figures.workload) {
+            if self.method(label).is_none() {
+                return Err(HilError::invalid_parameter(
+                    "figures",
+                    label,
+                    "no method has that label",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The w_task the figures (and the CLI's summary) use: the figure
+    /// settings' if the run scores it, else the first w_task.
+    pub fn figure_w_task(&self) -> f64 {
+        let w = self.figures.w_task;
+        if self.w_tasks.iter().any(|x| (x - w).abs() < 1e-9) {
+            w
+        } else {
+            self.w_tasks.first().copied().unwrap_or(w)
+        }
+    }
+
+    /// The method labelled `label`.
+    pub fn method(&self, label: &str) -> Option<&Method> {
+        self.methods.iter().find(|m| m.label == label)
+    }
+
+    /// Environment seed `i`.
+    pub fn env_seed(&self, i: usize) -> u64 {
+        splitmix(self.seed, 100 + i as u64)
+    }
+
+    /// Policy seed `j`.
+    pub fn policy_seed(&self, j: usize) -> u64 {
+        splitmix(self.seed, 200 + j as u64)
+    }
+}
+
+/// A workload model with the name it is reported under.
+#[derive(Clone)]
+pub struct NamedModel {
+    /// Name, e.g. `f1_sim`.
+    pub name: String,
+    /// The model.
+    pub model: Arc<dyn WorkloadModel>,
+}
+
+impl std::fmt::Debug for NamedModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NamedModel")
+            .field("name", &self.name)
+            .finish()
+    }
+}
+
+/// Validation or test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    /// Hyperparameters are chosen here.
+    Validation,
+    /// Chosen hyperparameters are evaluated here.
+    Test,
+}
+
+/// Identifies one episode.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunKey {
+    /// Phase.
+    pub phase: Phase,
+    /// Index of the method in [`ProtocolSettings::methods`].
+    pub method: usize,
+    /// The grid point (tuned hyperparameter and value), if tuned.
+    pub point: GridPoint,
+    /// Index of the model the policy decides with (methods that read the
+    /// workload forecast only).
+    pub decide_model: Option<usize>,
+    /// Environment seed index.
+    pub seed: usize,
+    /// Policy seed index (0 for deterministic methods).
+    pub policy_seed: usize,
+}
+
+/// What one step of a run looked like (enough for plots).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepTrace {
+    /// Timestep.
+    pub t: Timestep,
+    /// Item index.
+    pub item_index: usize,
+    /// The item's food.
+    pub food: String,
+    /// A query was asked at this step.
+    pub query: bool,
+    /// The gap G, if the policy reported it.
+    pub gap: Option<f64>,
+    /// The threshold G was compared with, if reported.
+    pub threshold: Option<f64>,
+    /// The attempt succeeded.
+    pub success: bool,
+}
+
+/// One finished episode.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// Which episode.
+    pub key: RunKey,
+    /// Metrics from hil-core, scored with the session's workload model (the
+    /// deciding model, or the first model for methods that do not read it);
+    /// [`EpisodeMetrics::rescored`] scores them under any other.
+    pub metrics: EpisodeMetrics,
+    /// Every step.
+    pub steps: Vec<StepTrace>,
+}
+
+impl RunRecord {
+    /// WL_t under `model` at every timestep 0..=T (the curve the paper plots).
+    pub fn workload_curve(&self, model: &dyn WorkloadModel) -> Result<Vec<f64>> {
+        let m = &self.metrics;
+        (0..=m.t_final)
+            .map(|t| hil_core::workload::workload_at(model, m.wl0, &m.queries, t))
+            .collect()
+    }
+}
+
+/// The protocol, ready to run.
+pub struct Protocol {
+    /// Settings.
+    pub settings: ProtocolSettings,
+    /// The dataset.
+    pub dataset: Arc<FoodDataset>,
+    /// Workload models (decision and scoring).
+    pub models: Vec<NamedModel>,
+    /// Builds the simulated expert for every episode (the paper's: a
+    /// perfect expert answering with the best action).
+    pub channel: fn() -> Box<dyn QueryChannel>,
+}
+
+impl std::fmt::Debug for Protocol {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Protocol")
+            .field("settings", &self.settings)
+            .field("dataset", &self.dataset.name)
+            .field("models", &self.models)
+            .finish()
+    }
+}
+
+/// The paper's simulated expert for [`Protocol::channel`].
+pub fn perfect_expert() -> Box<dyn QueryChannel> {
+    Box::new(hil_channels::SimulatedExpert::perfect())
+}
+
+impl Protocol {
+    /// The paper's protocol over `dataset` and `models`, with its perfect expert.
+    pub fn new(settings: ProtocolSettings, dataset: Arc<FoodDataset>, models: Vec<NamedModel>) -> Self {
+        Self {
+            settings,
+            dataset,
+            models,
+            channel: perfect_expert,
+        }
+    }
+
+    /// The build context of every policy: the dataset's actions and
+    /// dimension, and the pretraining foods' data.
+    pub fn build_context(&self) -> Result<BuildContext> {
+        let s = &self.settings;
+        let mut ctx = BuildContext::new(".", s.seed);
+        ctx.action_space = Some(self.dataset.actions.clone());
+        ctx.context_dim = Some(self.dataset.context_dim);
+        let data = pretraining_data(
+            &self.dataset,
+            &s.split.pretrain,
+            PretrainReward::Probability,
+            s.seed,
+        )?;
+        ctx.pretraining = Some(data.into());
+        Ok(ctx)
+    }
+
+    /// Every episode the protocol needs, each exactly once.
+    pub fn jobs(&self) -> Result<Vec<RunKey>> {
+        let s = &self.settings;
+        let mut specs: Vec<(usize, GridPoint, Option<usize>, usize)> = Vec::new();
+        for (i, m) in s.methods.iter().enumerate() {
+            for point in m.grid() {
+                let cfg = m.config(&point)?;
+                let n_ps = if cfg.is_stochastic() {
+                    s.n_policy_seeds
+                } else {
+                    1
+                };
+                if cfg.uses_workload_forecast() {
+                    for d in 0..self.models.len() {
+                        specs.push((i, point.clone(), Some(d), n_ps));
+                    }
+                } else {
+                    specs.push((i, point.clone(), None, n_ps));
+                }
+            }
+        }
+        let mut jobs = Vec::new();
+        for phase in [Phase::Validation, Phase::Test] {
+            for (method, point, decide_model, n_ps) in &specs {
+                for seed in 0..s.n_seeds {
+                    for policy_seed in 0..*n_ps {
+                        jobs.push(RunKey {
+                            phase,
+                            method: *method,
+                            point: point.clone(),
+                            decide_model: *decide_model,
+                            seed,
+                            policy_seed,
+                        });
+                    }
+                }
+            }
+        }
+        Ok(jobs)
+    }
+
+    /// Runs one episode.
+    pub fn run_one(&self, key: &RunKey, ctx: &BuildContext) -> Result<RunRecord> {
+        let s = &self.settings;
+        let foods = match key.phase {
+            Phase::Validation => &s.split.validation,
+            Phase::Test => &s.split.test,
+        };
+        let method = s.methods.get(key.method).ok_or_else(|| {
+            HilError::invalid_parameter("method", key.method, "no method at that index")
+        })?;
+        let mut env = DatasetReplayEnv::new(self.dataset.clone(), foods, s.items_per_episode)?;
+        let mut policy = method.config(&key.point)?.build(ctx)?;
+        let mut channel = (self.channel)();
+        // Methods that ignore the forecast are scored with the first model;
+        // the tables rescore every run under each model anyway.
+        let model = self.models[key.decide_model.unwrap_or(0)].model.clone();
+        let env_seed = s.env_seed(key.seed);
+        let label = splitmix(env_seed, key.policy_seed as u64);
+        let seeds = ComponentSeeds {
+            environment: env_seed,
+            policy: s.policy_seed(key.policy_seed),
+            channel: ComponentSeeds::derive(label).channel,
+        };
+        let mut session = Session {
+            settings: s.session.clone(),
+            environment: &mut env,
+            policy: policy.as_mut(),
+            channel: channel.as_mut(),
+            workload: model,
+            forecast: None,
+        };
+        let report = session.run_episode_with_seeds(label, seeds, &mut [])?;
+        let steps = report
+            .events
+            .iter()
+            .map(|e| {
+                let st = &e.step;
+                StepTrace {
+                    t: st.t,
+                    item_index: st.item_index,
+                    food: st.item_label.clone(),
+                    query: matches!(st.decision, StepDecision::Query { .. }),
+                    gap: st.diagnostics.as_ref().and_then(|d| d.gap),
+                    threshold: st.diagnostics.as_ref().and_then(|d| d.threshold),
+                    success: e.outcome.success,
+                }
+            })
+            .collect();
+        Ok(RunRecord {
+            key: key.clone(),
+            metrics: report.metrics,
+            steps,
+        })
+    }
+
+    /// Runs every job in parallel (rayon's pool: `RAYON_NUM_THREADS` or
+    /// all cores), calling `progress(done, total)` after each, and returns
+    /// the records in job order. The first failing run's error is returned,
+    /// naming the run.
+    pub fn run_all(&self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Vec<RunRecord>> {
+        self.settings.validate(&self.dataset, &self.models)?;
+        let jobs = self.jobs()?;
+        let ctx = self.build_context()?;
+        let total = jobs.len();
+        let done = AtomicUsize::new(0);
+        jobs.par_iter()
+            .map(|key| {
+                let r = self.run_one(key, &ctx).map_err(|e| {
+                    let m = &self.settings.methods[key.method];
+                    HilError::state(
+                        "protocol",
+                        format!(
+                            "run of `{}` {:?} ({:?}, seed {}, policy seed {}) failed: {e}",
+                            m.label, key.point, key.phase, key.seed, key.policy_seed
+                        ),
+                    )
+                });
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                r
+            })
+            .collect()
+    }
+}

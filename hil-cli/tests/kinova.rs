@@ -147,7 +147,13 @@ fn demo_error(name: &str, text: &str) -> (String, String) {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
-    let out = hil(&["demo", "kinova", "--quiet", "--components", path.to_str().unwrap()]);
+    let out = hil(&[
+        "demo",
+        "kinova",
+        "--quiet",
+        "--components",
+        path.to_str().unwrap(),
+    ]);
     std::fs::remove_file(&path).ok();
     assert!(!out.status.success());
     (

@@ -34,7 +34,10 @@ fn shipped_file_is_the_paper_protocol() {
 
 #[test]
 fn an_empty_file_is_the_paper_protocol() {
-    assert_eq!(as_toml(&parse("").unwrap()), as_toml(&UserStudyConfig::paper()));
+    assert_eq!(
+        as_toml(&parse("").unwrap()),
+        as_toml(&UserStudyConfig::paper())
+    );
 }
 
 #[test]
@@ -89,7 +92,12 @@ fn unknown_policy_type_is_located() {
     let text = "[[methods]]\nlabel = \"X\"\npolicy = { type = \"linucbb\", alpha = 0.5 }\n";
     let err = parse(text).unwrap_err();
     assert_eq!(err.line, 3, "{err}");
-    assert!(err.field.as_deref().is_some_and(|f| f.starts_with("methods")), "{err}");
+    assert!(
+        err.field
+            .as_deref()
+            .is_some_and(|f| f.starts_with("methods")),
+        "{err}"
+    );
 }
 
 #[test]
@@ -190,5 +198,8 @@ fn run_with_lets_the_caller_observe_every_plate() {
         )
         .unwrap();
     assert_eq!(plates, ["LinUCB", "AlwaysQuery", "LinUCB-QG"]);
-    assert_eq!(steps.0, result.plates.iter().map(|p| p.n_steps).sum::<usize>());
+    assert_eq!(
+        steps.0,
+        result.plates.iter().map(|p| p.n_steps).sum::<usize>()
+    );
 }

@@ -249,7 +249,6 @@ fn cell(rate: f64, published: Option<f64>) -> String {
     format!("{rate:.2} ({p})")
 }
 
-
 /// What the results are, printed with them.
 const NOTE: &str = "simulation of the user-study protocol; food properties are synthetic, \
                     calibrated to published success rates, and the workload model is fitted \
@@ -295,8 +294,9 @@ fn kinova_scene(cfg: &UserStudyConfig, base: &Path) -> Result<Option<KinovaFeedi
         return Ok(None);
     }
     table.remove("type");
-    let mut scene: KinovaFeedingConfig =
-        value.try_into().map_err(|e| HilError::serde("environment", e))?;
+    let mut scene: KinovaFeedingConfig = value
+        .try_into()
+        .map_err(|e| HilError::serde("environment", e))?;
     // As the config's own build does: a custom scene is relative to the file.
     scene.mjcf = scene.mjcf.map(|p| cfg.context(base).resolve(&p));
     KinovaFeedingEnv::new(scene).map(Some)
@@ -329,7 +329,11 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
     let mut writer = None;
     let result = match scene {
         Some(mut env) => {
-            writer = match args.render.as_deref().map(|d| KeyframeWriter::new(d, env.simulator())) {
+            writer = match args
+                .render
+                .as_deref()
+                .map(|d| KeyframeWriter::new(d, env.simulator()))
+            {
                 Some(Ok(w)) => Some(w),
                 Some(Err(why)) => {
                     eprintln!("note: rendering unavailable ({why}); continuing without pictures");

@@ -50,10 +50,7 @@ pub struct UserStudyConfig {
     #[serde(default = "paper_repetitions")]
     pub repetitions: usize,
     /// Session-loop settings, merged key by key over the paper's.
-    #[serde(
-        default = "paper_session",
-        deserialize_with = "session_over_paper"
-    )]
+    #[serde(default = "paper_session", deserialize_with = "session_over_paper")]
     pub session: SessionSettings,
     /// Where the robot acts; built once and shared by every plate, because
     /// building it (e.g. simulating pretraining attempts) may be expensive.
@@ -161,10 +158,7 @@ fn paper_policy<T: PolicyConfig + serde::de::DeserializeOwned + 'static>(
 
 fn paper_methods() -> Vec<MethodConfig> {
     vec![
-        MethodConfig::new(
-            "LinUCB",
-            paper_policy::<hil_policies::LinUcbConfig>(&[]),
-        ),
+        MethodConfig::new("LinUCB", paper_policy::<hil_policies::LinUcbConfig>(&[])),
         MethodConfig::new(
             "AlwaysQuery",
             paper_policy::<hil_policies::AlwaysQueryConfig>(&[]),

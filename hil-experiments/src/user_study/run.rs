@@ -123,7 +123,8 @@ pub struct MethodSummary {
 
 impl MethodSummary {
     fn over(method: &str, plates: &[&PlateResult]) -> Self {
-        let col = |f: fn(&PlateResult) -> f64| mean_sem(&plates.iter().map(|p| f(p)).collect::<Vec<_>>());
+        let col =
+            |f: fn(&PlateResult) -> f64| mean_sem(&plates.iter().map(|p| f(p)).collect::<Vec<_>>());
         let r = col(|p| p.r_task_avg);
         let s = col(|p| p.n_success as f64);
         let q = col(|p| p.n_q as f64);
@@ -210,7 +211,10 @@ impl UserStudyConfig {
             .iter()
             .map(|m| {
                 m.policy.build(&ctx).map_err(|e| {
-                    hil_core::HilError::invalid_input(format!("method `{}`", m.label), e.to_string())
+                    hil_core::HilError::invalid_input(
+                        format!("method `{}`", m.label),
+                        e.to_string(),
+                    )
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -251,7 +255,11 @@ impl UserStudyConfig {
     ) -> Result<UserStudyResult> {
         let mut env = self.build_environment(base_dir)?;
         let mut study = self.prepare(base_dir, env.as_ref())?;
-        study.run_with(env.as_mut(), |_, env, episode| episode(env, &mut []), |p| on_plate(p))
+        study.run_with(
+            env.as_mut(),
+            |_, env, episode| episode(env, &mut []),
+            |p| on_plate(p),
+        )
     }
 }
 
@@ -297,19 +305,19 @@ impl UserStudy<'_> {
             let mut channel = cfg.channel.build(&self.ctx)?;
             let policy = self.policies[plate.method].as_mut();
             let workload = Arc::clone(&self.workload);
-            let mut episode = |env: &mut dyn Environment,
-                               observers: &mut [&mut dyn SessionObserver]| {
-                env_name = env.name().to_string();
-                Session {
-                    settings: cfg.session.clone(),
-                    environment: env,
-                    policy: &mut *policy,
-                    channel: channel.as_mut(),
-                    workload: Arc::clone(&workload),
-                    forecast: None,
-                }
-                .run_episode(plate.seed, observers)
-            };
+            let mut episode =
+                |env: &mut dyn Environment, observers: &mut [&mut dyn SessionObserver]| {
+                    env_name = env.name().to_string();
+                    Session {
+                        settings: cfg.session.clone(),
+                        environment: env,
+                        policy: &mut *policy,
+                        channel: channel.as_mut(),
+                        workload: Arc::clone(&workload),
+                        forecast: None,
+                    }
+                    .run_episode(plate.seed, observers)
+                };
             let report = each(&plate, env, &mut episode)?;
             for e in &report.events {
                 if !foods.contains(&e.step.item_label) {
@@ -385,7 +393,14 @@ mod tests {
         let orders: Vec<Vec<usize>> = (0..6).map(|r| method_order(r, 3)).collect();
         assert_eq!(
             orders,
-            [[0, 1, 2], [2, 1, 0], [1, 2, 0], [0, 2, 1], [2, 0, 1], [1, 0, 2]]
+            [
+                [0, 1, 2],
+                [2, 1, 0],
+                [1, 2, 0],
+                [0, 2, 1],
+                [2, 0, 1],
+                [1, 0, 2]
+            ]
         );
     }
 

@@ -56,16 +56,36 @@ fn calibrate_prints_rates_beside_the_published_ones() {
 }
 
 #[test]
-fn the_demo_runs_the_protocol_and_renders_or_says_why_not() {
+fn the_demo_runs_a_study_file_and_renders_or_says_why_not() {
     let dir = std::env::temp_dir().join(format!("hil-kinova-demo-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let components = dir.join("components.toml");
+    let study = dir.join("study.toml");
+    // Repetitions and N_att come from the flags, which override the file;
+    // the workload model is the default one, left out.
     std::fs::write(
-        &components,
-        "[environment]\npretraining_trials = 0\ncontext_dim = 8\n\
-         [linucb]\ntype = \"linucb\"\nalpha = 0.5\n\
-         [always_query]\ntype = \"always_query\"\nalpha = 0.5\n\
-         [linucb_qg]\ntype = \"linucb_qg\"\nalpha = 0.5\nw = 0.3\n",
+        &study,
+        r#"
+repetitions = 2
+[session]
+n_att = 3
+[environment]
+type = "kinova_feeding"
+pretraining_trials = 0
+context_dim = 8
+[channel]
+type = "simulated_expert"
+error_rate = 0.2
+decline_rate = 0.1
+[[methods]]
+label = "LinUCB"
+policy = { type = "linucb", alpha = 0.5 }
+[[methods]]
+label = "AlwaysQuery"
+policy = { type = "always_query", alpha = 0.5 }
+[[methods]]
+label = "LinUCB-QG"
+policy = { type = "linucb_qg", alpha = 0.5, w = 0.3 }
+"#,
     )
     .unwrap();
     let frames = dir.join("frames");
@@ -79,13 +99,17 @@ fn the_demo_runs_the_protocol_and_renders_or_says_why_not() {
         "--json",
         "--quiet",
         "--components",
-        components.to_str().unwrap(),
+        study.to_str().unwrap(),
         "--render",
         frames.to_str().unwrap(),
     ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["protocol"]["n_att"], 1);
+    assert_eq!(v["protocol"]["repetitions"], 1);
+    assert_eq!(v["protocol"]["environment"], "kinova_feeding");
+    assert!(v["note"].as_str().unwrap().contains("synthetic"));
     let plates = v["plates"].as_array().unwrap();
     assert_eq!(plates.len(), 3);
     let methods: Vec<&str> = plates
@@ -96,6 +120,10 @@ fn the_demo_runs_the_protocol_and_renders_or_says_why_not() {
     // LinUCB never asks; AlwaysQuery asks about every item.
     assert_eq!(plates[0]["n_q"], 0);
     assert_eq!(plates[1]["n_q"], 3);
+    // One plate per method: the standard error is undefined, and says so.
+    let summary = &v["methods"][0];
+    assert_eq!(summary["plates"], 1);
+    assert!(summary["r_task_avg"].is_number() && summary["r_task_avg_sem"].is_null());
     // Five keyframes per attempt, or a clear note that EGL is unavailable.
     let pngs = std::fs::read_dir(&frames)
         .map(|d| {
@@ -110,11 +138,51 @@ fn the_demo_runs_the_protocol_and_renders_or_says_why_not() {
         pngs == 5 * 9 || stderr.contains("rendering unavailable"),
         "{pngs} pictures; {stderr}"
     );
-
-    let bad = dir.join("bad.toml");
-    std::fs::write(&bad, "[polcy]\n").unwrap();
-    let out = hil(&["demo", "kinova", "--components", bad.to_str().unwrap()]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("polcy"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Runs `hil demo kinova` on a study file that is wrong and returns stderr.
+fn demo_error(name: &str, text: &str) -> (String, String) {
+    let dir = std::env::temp_dir().join(format!("hil-kinova-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    let out = hil(&[
+        "demo",
+        "kinova",
+        "--quiet",
+        "--components",
+        path.to_str().unwrap(),
+    ]);
+    std::fs::remove_file(&path).ok();
+    assert!(!out.status.success());
+    (
+        path.display().to_string(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn errors_in_a_study_file_name_file_line_and_field() {
+    let (path, stderr) = demo_error(
+        "channel.toml",
+        "repetitions = 1\n[channel]\ntype = \"simulated_expert\"\nerror_rat = 0.1\n",
+    );
+    assert!(stderr.contains(&format!("{path}:4:")), "{stderr}");
+    assert!(stderr.contains("channel.error_rat"), "{stderr}");
+
+    let (path, stderr) = demo_error(
+        "policy.toml",
+        "[[methods]]\nlabel = \"LinUCB\"\n[methods.policy]\ntype = \"linucb\"\nalpha = \"high\"\n",
+    );
+    assert!(stderr.contains(&format!("{path}:5:")), "{stderr}");
+    assert!(stderr.contains("methods.policy.alpha"), "{stderr}");
+
+    let (path, stderr) = demo_error("table.toml", "[polcy]\n");
+    assert!(stderr.contains(&format!("{path}:1:")), "{stderr}");
+    assert!(stderr.contains("polcy"), "{stderr}");
+
+    let out = hil(&["demo", "kinova", "--repetitions", "0"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--repetitions"));
 }

@@ -121,6 +121,22 @@ impl BuildContext {
         }
     }
 
+    /// Records what policy and channel factories need to know about a built
+    /// environment: its action space, its context dimension and the
+    /// pretraining data its `config` offers. Every protocol that builds an
+    /// environment and then the components around it calls this between the
+    /// two, so they all see the same facts.
+    pub fn describe_environment(
+        &mut self,
+        config: &dyn EnvironmentConfig,
+        environment: &dyn Environment,
+    ) -> Result<()> {
+        self.action_space = Some(environment.action_space().clone());
+        self.context_dim = Some(environment.context_dim());
+        self.pretraining = config.pretraining(self)?;
+        Ok(())
+    }
+
     /// Resolves `path` against the config's directory unless it is absolute.
     pub fn resolve(&self, path: &Path) -> PathBuf {
         if path.is_absolute() {

@@ -82,9 +82,7 @@ impl ExperimentConfig {
     pub fn build(&self, base_dir: &Path) -> Result<Experiment> {
         let mut ctx = BuildContext::new(base_dir, self.seed);
         let environment = self.environment.build(&ctx)?;
-        ctx.action_space = Some(environment.action_space().clone());
-        ctx.context_dim = Some(environment.context_dim());
-        ctx.pretraining = self.environment.pretraining(&ctx)?;
+        ctx.describe_environment(self.environment.as_ref(), environment.as_ref())?;
         let policy = self.policy.build(&ctx)?;
         let workload = self.workload.build(&ctx)?;
         let forecast = match &self.policy_workload {

@@ -8,6 +8,8 @@
 //! - [`testbed`]: the paper's simulated-testbed protocol (methods as policy
 //!   configs, runs in parallel, hyperparameters chosen on validation, the
 //!   cross-data experiment);
+//! - [`user_study`]: the paper's real-robot user-study protocol (methods
+//!   in counterbalanced order, per-plate results, mean ± standard error);
 //! - [`results`]: selection and aggregation; [`report`]: Markdown tables
 //!   beside the paper's published numbers ([`published`], read from data
 //!   files); [`plot`]: SVG figures; [`output`]: writes them all.
@@ -22,5 +24,7 @@ pub mod published;
 pub mod report;
 pub mod results;
 pub mod testbed;
+pub mod user_study;
 
 pub use testbed::{Method, NamedModel, Protocol, ProtocolSettings};
+pub use user_study::{UserStudy, UserStudyConfig, UserStudyResult};

@@ -4,23 +4,22 @@
 //! - `hil kinova calibrate --trials 30 --json` runs every (food, action)
 //!   pair in randomised simulated attempts and prints the achieved success
 //!   rate beside the published one, with attempts per second.
-//! - `hil demo kinova` runs the paper's real-robot user-study protocol in
-//!   simulation: a plate of banana, carrot and cantaloupe, N_att = 3, the
-//!   methods LinUCB, AlwaysQuery and LinUCB-QG, 2 repetitions in
-//!   counterbalanced order; prints r_task_avg, n_success and n_q per plate.
+//! - `hil demo kinova` runs the paper's real-robot user-study protocol
+//!   (`hil_experiments::user_study`) in simulation: a plate of banana,
+//!   carrot and cantaloupe, N_att = 3, the methods LinUCB, AlwaysQuery and
+//!   LinUCB-QG, 2 repetitions in counterbalanced order; prints r_task_avg,
+//!   n_success and n_q per plate and their mean ± standard error per method.
+//!   This file only reads arguments, renders keyframes and prints.
 
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
-
-use hil_core::config::{BuildContext, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
-use hil_core::{Environment, HilError, Result, Session, SessionSettings};
 use std::io::Write;
+use std::path::{Path, PathBuf};
 
+use hil_core::{HilError, Result};
+use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyResult};
 use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
 use hil_kinova_mujoco::food::{Label, parse_labels};
 use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
 use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
-use serde::Serialize;
 
 /// Arguments of `hil kinova`.
 #[derive(Debug, clap::Args)]
@@ -84,22 +83,32 @@ pub enum DemoCommand {
 /// Arguments of `hil demo kinova`.
 #[derive(Debug, clap::Args)]
 pub struct KinovaDemoArgs {
-    /// Repetitions of each method.
-    #[arg(long, default_value_t = 2)]
-    pub repetitions: usize,
-    /// Attempts per item (N_att).
-    #[arg(long, default_value_t = 3)]
-    pub n_att: u32,
-    /// Master seed.
-    #[arg(long, default_value_t = 7)]
-    pub seed: u64,
-    /// Write PNG keyframes of every attempt into this directory (offscreen EGL).
+    /// Repetitions of each method [default: the file's, else 2].
+    #[arg(long)]
+    pub repetitions: Option<usize>,
+    /// Attempts per item, N_att [default: the file's, else 3].
+    #[arg(long)]
+    pub n_att: Option<u32>,
+    /// Master seed [default: the file's, else 7].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Write PNG keyframes of every attempt into this directory (offscreen
+    /// EGL; needs the `kinova_feeding` environment).
     #[arg(long)]
     pub render: Option<PathBuf>,
-    /// TOML overriding the components: tables `linucb`, `always_query`,
-    /// `linucb_qg` (policy configs), `workload`, `channel` and `environment`
-    /// (a `kinova_feeding` config without `type`).
-    #[arg(long)]
+    /// A user-study file (see examples/configs/user-study.toml) changing
+    /// the protocol.
+    ///
+    /// Top-level keys: `plugins`, `seed`, `repetitions`, `[session]`,
+    /// `[environment]`, `[workload]`, `[channel]` and `[[methods]]` (each a
+    /// `label` and a `policy` table). Components are named by `type`, built
+    /// in or registered by a plugin the file lists. Every key may be left
+    /// out and then takes the paper's protocol, which is that example file:
+    /// a component table or the methods list given in the file replaces the
+    /// default one as a whole; `[session]` is merged key by key. The flags
+    /// --repetitions, --n-att and --seed override the file. Errors name the
+    /// file, line and field.
+    #[arg(long, verbatim_doc_comment)]
     pub components: Option<PathBuf>,
     /// Print a JSON object instead of a table.
     #[arg(long)]
@@ -240,312 +249,209 @@ fn cell(rate: f64, published: Option<f64>) -> String {
     format!("{rate:.2} ({p})")
 }
 
-/// The methods of the user study, in the paper's order.
-const METHODS: [(&str, &str); 3] = [
-    ("LinUCB", "linucb"),
-    ("AlwaysQuery", "always_query"),
-    ("LinUCB-QG", "linucb_qg"),
-];
+/// What the results are, printed with them.
+const NOTE: &str = "simulation of the user-study protocol; food properties are synthetic, \
+                    calibrated to published success rates, and the workload model is fitted \
+                    to synthetic study data: these are not the paper's results";
 
-/// Counterbalanced method order for repetition `rep`: the second
-/// repetition reverses the first (ABC, CBA: every method's mean position
-/// is the same), and six repetitions use all six orders.
-fn method_order(rep: usize) -> [usize; 3] {
-    const ORDERS: [[usize; 3]; 6] = [
-        [0, 1, 2],
-        [2, 1, 0],
-        [1, 2, 0],
-        [0, 2, 1],
-        [2, 0, 1],
-        [1, 0, 2],
-    ];
-    ORDERS[rep % 6]
-}
-
-#[derive(Debug, Serialize)]
-struct PlateResult {
-    method: &'static str,
-    repetition: usize,
-    position: usize,
-    r_task_avg: f64,
-    n_success: usize,
-    n_q: usize,
-    n_steps: usize,
-}
-
-#[derive(Debug, Serialize)]
-struct MethodSummary {
-    method: &'static str,
-    r_task_avg: f64,
-    n_success_per_plate: f64,
-    n_q_per_plate: f64,
-}
-
-fn components(path: Option<&Path>) -> Result<toml::Table> {
-    let Some(path) = path else {
-        return Ok(toml::Table::new());
-    };
-    let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
-    let table: toml::Table = toml::from_str(&text)
-        .map_err(|e| HilError::invalid_input(path.display().to_string(), e.to_string()))?;
-    for key in table.keys() {
-        if ![
-            "linucb",
-            "always_query",
-            "linucb_qg",
-            "workload",
-            "environment",
-        ]
-        .contains(&key.as_str())
-        {
-            return Err(HilError::invalid_input(
-                format!("{}: table `{key}`", path.display()),
-                "unknown; expected linucb, always_query, linucb_qg, workload, channel or environment",
-            ));
+/// The study `hil demo kinova` runs: the paper's protocol, changed by
+/// `--components` and then by the flags.
+fn demo_config(args: &KinovaDemoArgs) -> Result<UserStudyConfig> {
+    for (flag, zero) in [
+        ("--repetitions", args.repetitions == Some(0)),
+        ("--n-att", args.n_att == Some(0)),
+    ] {
+        if zero {
+            return Err(HilError::invalid_parameter(flag, 0, "must be at least 1"));
         }
     }
-    Ok(table)
-}
-
-/// Default policy parameters of the demo (override with `--components`):
-/// α = 0.5 for all three, LinUCB-QG workload weight w = 0.3, all
-/// pretrained on the environment's simulated pretraining attempts.
-fn default_policy(key: &str) -> toml::Value {
-    let mut t = toml::Table::new();
-    t.insert("type".into(), toml::Value::String(key.into()));
-    t.insert("alpha".into(), toml::Value::Float(0.5));
-    t.insert("pretrain".into(), toml::Value::Boolean(true));
-    if key == "linucb_qg" {
-        t.insert("w".into(), toml::Value::Float(0.3));
+    let mut cfg = match &args.components {
+        Some(path) => UserStudyConfig::load(path)?,
+        None => UserStudyConfig::paper(),
+    };
+    if let Some(r) = args.repetitions {
+        cfg.repetitions = r;
     }
-    toml::Value::Table(t)
+    if let Some(n) = args.n_att {
+        cfg.session.n_att = n;
+    }
+    if let Some(s) = args.seed {
+        cfg.seed = s;
+    }
+    cfg.validate()?;
+    Ok(cfg)
 }
 
-fn policy_config(table: &toml::Table, key: &str) -> Result<Box<dyn PolicyConfig>> {
-    let value = table
-        .get(key)
-        .cloned()
-        .unwrap_or_else(|| default_policy(key));
-    value.try_into().map_err(|e: toml::de::Error| {
-        HilError::invalid_input(
-            format!("policy `{key}`"),
-            format!("{e} (is hil-policies built in, with a policy type named `{key}`?)"),
-        )
-    })
-}
-
-/// The participant answering queries: hil-channels' `simulated_expert`
-/// (a perfect expert by default) unless `[channel]` says otherwise.
-fn channel_config(table: &toml::Table) -> Result<Box<dyn QueryChannelConfig>> {
-    let value = table.get("channel").cloned().unwrap_or_else(|| {
-        let mut t = toml::Table::new();
-        t.insert(
-            "type".into(),
-            toml::Value::String("simulated_expert".into()),
-        );
-        toml::Value::Table(t)
-    });
-    value
+/// The `[environment]` as the concrete MuJoCo scene, when it is one:
+/// keyframes are recorded around the scene's own attempts.
+fn kinova_scene(cfg: &UserStudyConfig, base: &Path) -> Result<Option<KinovaFeedingEnv>> {
+    let mut value =
+        toml::Value::try_from(&cfg.environment).map_err(|e| HilError::serde("environment", e))?;
+    let Some(table) = value.as_table_mut() else {
+        return Ok(None);
+    };
+    if table.get("type").and_then(toml::Value::as_str) != Some("kinova_feeding") {
+        return Ok(None);
+    }
+    table.remove("type");
+    let mut scene: KinovaFeedingConfig = value
         .try_into()
-        .map_err(|e: toml::de::Error| HilError::invalid_input("channel", e.to_string()))
-}
-
-fn workload_config(table: &toml::Table) -> Result<Box<dyn WorkloadModelConfig>> {
-    let value = table.get("workload").cloned().unwrap_or_else(|| {
-        let mut t = toml::Table::new();
-        t.insert("type".into(), toml::Value::String("bundled".into()));
-        t.insert("name".into(), toml::Value::String("f12_real".into()));
-        toml::Value::Table(t)
-    });
-    value.try_into().map_err(|e: toml::de::Error| {
-        HilError::invalid_input(
-            "workload model",
-            format!("{e} (the default is hil-workload's bundled `f12_real`)"),
-        )
-    })
+        .map_err(|e| HilError::serde("environment", e))?;
+    // As the config's own build does: a custom scene is relative to the file.
+    scene.mjcf = scene.mjcf.map(|p| cfg.context(base).resolve(&p));
+    KinovaFeedingEnv::new(scene).map(Some)
 }
 
 fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
-    if args.repetitions == 0 || args.n_att == 0 {
-        return Err(HilError::invalid_parameter(
-            "--repetitions/--n-att",
-            format!("{}/{}", args.repetitions, args.n_att),
-            "must be at least 1",
-        ));
-    }
-    let table = components(args.components.as_deref())?;
-    let env_cfg: KinovaFeedingConfig = match table.get("environment") {
-        Some(v) => v
-            .clone()
-            .try_into()
-            .map_err(|e: toml::de::Error| HilError::invalid_input("environment", e.to_string()))?,
-        None => KinovaFeedingConfig {
-            pretraining_trials: 2,
-            ..KinovaFeedingConfig::default()
-        },
-    };
-    let mut env = KinovaFeedingEnv::new(env_cfg.clone())?;
+    let cfg = demo_config(&args)?;
     let base = args
         .components
         .as_deref()
         .and_then(Path::parent)
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from("."));
-    let mut ctx = BuildContext::new(&base, args.seed);
-    ctx.action_space = Some(env.action_space().clone());
-    ctx.context_dim = Some(env.context_dim());
-    if !args.quiet && env_cfg.pretraining_trials > 0 {
-        eprintln!(
-            "simulating {} pretraining attempts per (food, action)",
-            env_cfg.pretraining_trials
-        );
+    let quiet = args.quiet;
+    if !quiet {
+        eprintln!("building the environment and its pretraining data (once, for every method)");
     }
-    ctx.pretraining = hil_core::config::EnvironmentConfig::pretraining(&env_cfg, &ctx)?;
-    let workload = workload_config(&table)?.build(&ctx)?;
-    let mut policies = Vec::new();
-    for (label, key) in METHODS {
-        let p = policy_config(&table, key)?
-            .build(&ctx)
-            .map_err(|e| HilError::invalid_input(format!("policy {label}"), e.to_string()))?;
-        policies.push(p);
-    }
-    let mut writer = match &args.render {
-        Some(dir) => match KeyframeWriter::new(dir, env.simulator()) {
-            Ok(w) => Some(w),
-            Err(why) => {
-                eprintln!("note: rendering unavailable ({why}); continuing without pictures");
-                None
-            }
-        },
+    let progress = |plate: &Plate| {
+        if !quiet {
+            eprintln!(
+                "repetition {} plate {}: {}",
+                plate.repetition, plate.position, plate.label
+            );
+        }
+    };
+    let scene = match &args.render {
+        Some(_) => kinova_scene(&cfg, &base)?,
         None => None,
     };
-    let mut recorder = KeyframeRecorder::default();
-    let settings = SessionSettings {
-        n_att: args.n_att,
-        wl0: 0.5,
-        max_items: None,
-    };
-    let mut plates = Vec::new();
-    for rep in 0..args.repetitions {
-        for (position, &m) in method_order(rep).iter().enumerate() {
-            let (label, _) = METHODS[m];
-            if !args.quiet {
-                eprintln!("repetition {} plate {}: {label}", rep + 1, position + 1);
-            }
-            let seed = hil_core::session::splitmix(args.seed, (rep * 3 + position) as u64);
-            let mut channel = channel_config(&table)?.build(&ctx)?;
-            recorder.set_prefix(format!("rep{}_{}", rep + 1, METHODS[m].1));
-            let report = {
-                let mut render_env;
-                let environment: &mut dyn Environment = if writer.is_some() {
-                    render_env = RenderingEnv::new(&mut env, &mut recorder);
-                    &mut render_env
-                } else {
-                    &mut env
-                };
-                let mut session = Session {
-                    settings: settings.clone(),
-                    environment,
-                    policy: policies[m].as_mut(),
-                    channel: channel.as_mut(),
-                    workload: Arc::clone(&workload),
-                    forecast: None,
-                };
-                session.run_episode(seed, &mut [])?
-            };
-            if let Some(w) = writer.as_mut() {
-                if let Err(why) = w.write(&mut recorder) {
-                    eprintln!("note: {why}; continuing without pictures");
-                    writer = None;
+    let mut writer = None;
+    let result = match scene {
+        Some(mut env) => {
+            writer = match args
+                .render
+                .as_deref()
+                .map(|d| KeyframeWriter::new(d, env.simulator()))
+            {
+                Some(Ok(w)) => Some(w),
+                Some(Err(why)) => {
+                    eprintln!("note: rendering unavailable ({why}); continuing without pictures");
+                    None
                 }
+                None => None,
+            };
+            let mut recorder = KeyframeRecorder::default();
+            let mut study = cfg.prepare(&base, &env)?;
+            study.run_with(
+                &mut env,
+                |plate, env, episode| {
+                    progress(plate);
+                    let Some(w) = writer.as_mut() else {
+                        return episode(env, &mut []);
+                    };
+                    recorder.set_prefix(format!("rep{}_{}", plate.repetition, slug(&plate.label)));
+                    let report = episode(&mut RenderingEnv::new(env, &mut recorder), &mut [])?;
+                    if let Err(why) = w.write(&mut recorder) {
+                        eprintln!("note: {why}; continuing without pictures");
+                        writer = None;
+                    }
+                    Ok(report)
+                },
+                |_| {},
+            )?
+        }
+        None => {
+            if args.render.is_some() {
+                eprintln!(
+                    "note: rendering needs the `kinova_feeding` environment; continuing without pictures"
+                );
             }
-            plates.push(PlateResult {
-                method: label,
-                repetition: rep + 1,
-                position: position + 1,
-                r_task_avg: report.metrics.r_task_avg,
-                n_success: report.metrics.n_success,
-                n_q: report.metrics.n_q,
-                n_steps: report.metrics.n_steps,
-            });
+            let mut env = cfg.build_environment(&base)?;
+            let mut study = cfg.prepare(&base, env.as_ref())?;
+            study.run_with(
+                env.as_mut(),
+                |plate, env, episode| {
+                    progress(plate);
+                    episode(env, &mut [])
+                },
+                |_| {},
+            )?
         }
-    }
-    let summary: Vec<MethodSummary> = METHODS
-        .iter()
-        .map(|(label, _)| {
-            let rows: Vec<&PlateResult> = plates.iter().filter(|p| p.method == *label).collect();
-            let n = rows.len().max(1) as f64;
-            MethodSummary {
-                method: label,
-                r_task_avg: rows.iter().map(|p| p.r_task_avg).sum::<f64>() / n,
-                n_success_per_plate: rows.iter().map(|p| p.n_success as f64).sum::<f64>() / n,
-                n_q_per_plate: rows.iter().map(|p| p.n_q as f64).sum::<f64>() / n,
-            }
-        })
-        .collect();
-    if args.json {
-        let out = serde_json::json!({
-            "protocol": {"foods": ["banana", "carrot", "cantaloupe"], "n_att": args.n_att,
-                          "repetitions": args.repetitions, "seed": args.seed},
-            "plates": plates,
-            "methods": summary,
-            "note": "MuJoCo simulation of the user-study protocol; food properties are synthetic, calibrated to published success rates",
-        });
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
-        );
-    } else {
-        println!("User-study protocol in MuJoCo simulation (synthetic food properties).");
-        println!(
-            "{:<12} {:>4} {:>4} {:>11} {:>10} {:>4}",
-            "method", "rep", "pos", "r_task_avg", "n_success", "n_q"
-        );
-        for p in &plates {
-            println!(
-                "{:<12} {:>4} {:>4} {:>11.3} {:>10} {:>4}",
-                p.method, p.repetition, p.position, p.r_task_avg, p.n_success, p.n_q
-            );
-        }
-        println!("\nper method (mean over plates of 3 items):");
-        for s in &summary {
-            println!(
-                "{:<12} r_task_avg {:.3}  n_success {:.2}  n_q {:.2}",
-                s.method, s.r_task_avg, s.n_success_per_plate, s.n_q_per_plate
-            );
-        }
-    }
+    };
+    print_result(&result, args.json)?;
     if let Some(w) = writer {
         eprintln!("wrote {} keyframes to {}", w.written(), w.dir().display());
     }
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+/// A label as a file-name part: `LinUCB-QG` becomes `linucb_qg`.
+fn slug(label: &str) -> String {
+    label
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
 
-    #[test]
-    fn method_order_is_counterbalanced() {
-        // Two repetitions: equal mean position for every method.
-        let mut sum = [0; 3];
-        for rep in 0..2 {
-            for (p, &m) in method_order(rep).iter().enumerate() {
-                sum[m] += p;
-            }
-        }
-        assert_eq!(sum, [2, 2, 2]);
-        // Six repetitions: every method twice in every position.
-        let mut pos = [[0; 3]; 3];
-        for rep in 0..6 {
-            let o = method_order(rep);
-            let mut seen = o;
-            seen.sort();
-            assert_eq!(seen, [0, 1, 2]);
-            for (p, &m) in o.iter().enumerate() {
-                pos[m][p] += 1;
-            }
-        }
-        assert!(pos.iter().flatten().all(|&c| c == 2));
+/// `12.3 ± 0.4`, or the mean alone where one plate leaves the error undefined.
+fn pm(mean: f64, sem: Option<f64>, digits: usize) -> String {
+    match sem {
+        Some(s) => format!("{mean:.digits$} ± {s:.digits$}"),
+        None => format!("{mean:.digits$}"),
     }
+}
+
+fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
+    if json {
+        let out = serde_json::json!({
+            "protocol": result.protocol,
+            "plates": result.plates,
+            "methods": result.methods,
+            "note": NOTE,
+        });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
+        );
+        return Ok(());
+    }
+    let p = &result.protocol;
+    println!(
+        "User-study protocol in simulation ({}: {}; N_att = {}; {} repetitions; seed {}).",
+        p.environment,
+        p.foods.join(", "),
+        p.n_att,
+        p.repetitions,
+        p.seed
+    );
+    println!("Note: {NOTE}.");
+    println!(
+        "{:<12} {:>4} {:>4} {:>11} {:>10} {:>4}",
+        "method", "rep", "pos", "r_task_avg", "n_success", "n_q"
+    );
+    for p in &result.plates {
+        println!(
+            "{:<12} {:>4} {:>4} {:>11.3} {:>10} {:>4}",
+            p.method, p.repetition, p.position, p.r_task_avg, p.n_success, p.n_q
+        );
+    }
+    println!("\nper method (mean ± standard error over its plates):");
+    for s in &result.methods {
+        println!(
+            "{:<12} r_task_avg {}  n_success {}  n_q {}  ({} plates)",
+            s.method,
+            pm(s.r_task_avg, s.r_task_avg_sem, 3),
+            pm(s.n_success_per_plate, s.n_success_per_plate_sem, 2),
+            pm(s.n_q_per_plate, s.n_q_per_plate_sem, 2),
+            s.plates
+        );
+    }
+    Ok(())
 }

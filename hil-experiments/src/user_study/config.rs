@@ -1,0 +1,326 @@
+//! The user-study file: which environment, workload model, channel and
+//! methods, and how many repetitions.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use hil_core::config::{
+    BuildContext, ConfigError, EnvironmentConfig, PolicyConfig, QueryChannelConfig,
+    WorkloadModelConfig, load_plugins, parse_toml,
+};
+use hil_core::{HilError, Result, SessionSettings};
+use serde::de::Error as _;
+use serde::{Deserialize, Deserializer, Serialize};
+
+/// The real-robot user study of the paper as a config: every component by
+/// its `type` (built-in or registered by a plugin), and the methods the
+/// participant meets, each as many times as `repetitions` says.
+///
+/// Every key is optional: what a file leaves out is the paper's protocol
+/// ([`UserStudyConfig::paper`]). A component table (`[environment]`,
+/// `[workload]`, `[channel]`) or the `methods` array replaces the default
+/// as a whole, because another `type` has other parameters; `[session]` is
+/// merged key by key over the paper's session (N_att = 3, WL_0 = 0.5), so
+/// `wl0 = 0.4` alone keeps N_att = 3.
+///
+/// ```
+/// use hil_experiments::user_study::UserStudyConfig;
+/// let cfg = UserStudyConfig::parse(
+///     "repetitions = 1\n[channel]\ntype = \"simulated_expert\"\nerror_rate = 0.1\n",
+///     "study.toml".as_ref(),
+/// )
+/// .unwrap();
+/// assert_eq!(cfg.repetitions, 1);
+/// assert_eq!(cfg.session.n_att, 3); // the paper's, not given in the file
+/// assert_eq!(cfg.labels(), ["LinUCB", "AlwaysQuery", "LinUCB-QG"]);
+/// ```
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UserStudyConfig {
+    /// Shared libraries to load before the components are parsed, relative
+    /// to the file.
+    #[serde(default)]
+    pub plugins: Vec<PathBuf>,
+    /// Master seed: pretraining data and every plate's seed derive from it.
+    #[serde(default = "paper_seed")]
+    pub seed: u64,
+    /// How many times the participant meets every method (≥ 1); the order
+    /// of the methods is counterbalanced across repetitions
+    /// ([`crate::user_study::method_order`]).
+    #[serde(default = "paper_repetitions")]
+    pub repetitions: usize,
+    /// Session-loop settings, merged key by key over the paper's.
+    #[serde(default = "paper_session", deserialize_with = "session_over_paper")]
+    pub session: SessionSettings,
+    /// Where the robot acts; built once and shared by every plate, because
+    /// building it (e.g. simulating pretraining attempts) may be expensive.
+    #[serde(
+        default = "paper_environment",
+        deserialize_with = "hil_core::plugin::component"
+    )]
+    pub environment: Box<dyn EnvironmentConfig>,
+    /// The workload model that evolves and scores the participant's
+    /// workload, and that the policies forecast with.
+    #[serde(
+        default = "paper_workload",
+        deserialize_with = "hil_core::plugin::component"
+    )]
+    pub workload: Box<dyn WorkloadModelConfig>,
+    /// Who answers queries; a fresh channel is built for every plate.
+    #[serde(
+        default = "paper_channel",
+        deserialize_with = "hil_core::plugin::component"
+    )]
+    pub channel: Box<dyn QueryChannelConfig>,
+    /// The methods compared, in the order of the first repetition.
+    #[serde(default = "paper_methods")]
+    pub methods: Vec<MethodConfig>,
+}
+
+/// One method of the study: a label for the tables and a policy.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MethodConfig {
+    /// The method's name in results (unique within a study).
+    pub label: String,
+    /// The policy; it keeps learning from one of its plates to the next.
+    #[serde(deserialize_with = "hil_core::plugin::component")]
+    pub policy: Box<dyn PolicyConfig>,
+}
+
+impl MethodConfig {
+    /// A method named `label` deciding with `policy`.
+    pub fn new(label: impl Into<String>, policy: Box<dyn PolicyConfig>) -> Self {
+        Self {
+            label: label.into(),
+            policy,
+        }
+    }
+}
+
+/// The study's attempts per item (N_att), as in the paper's user study.
+pub const PAPER_N_ATT: u32 = 3;
+/// Initial workload WL_0 of every plate.
+const PAPER_WL0: f64 = 0.5;
+/// Confidence weight α of every method.
+const PAPER_ALPHA: f64 = 0.5;
+/// LinUCB-QG's workload weight w.
+const PAPER_W: f64 = 0.3;
+/// Simulated pretraining attempts per (food, action) in the MuJoCo scene:
+/// few, because each is a physics simulation.
+const PAPER_PRETRAINING_TRIALS: usize = 2;
+
+fn paper_seed() -> u64 {
+    7
+}
+fn paper_repetitions() -> usize {
+    2
+}
+fn paper_session() -> SessionSettings {
+    SessionSettings {
+        n_att: PAPER_N_ATT,
+        wl0: PAPER_WL0,
+        max_items: None,
+    }
+}
+fn paper_environment() -> Box<dyn EnvironmentConfig> {
+    Box::new(hil_kinova_mujoco::KinovaFeedingConfig {
+        pretraining_trials: PAPER_PRETRAINING_TRIALS,
+        ..Default::default()
+    })
+}
+fn paper_workload() -> Box<dyn WorkloadModelConfig> {
+    Box::new(hil_workload::config::BundledModelConfig {
+        name: "f12_real".into(),
+    })
+}
+fn paper_channel() -> Box<dyn QueryChannelConfig> {
+    Box::new(hil_channels::SimulatedExpertConfig::default())
+}
+
+/// The paper's parameters of one policy, read through the policy's own
+/// config type so that everything the paper leaves unsaid (λ, estimator,
+/// query kind) keeps that type's default.
+fn paper_policy<T: PolicyConfig + serde::de::DeserializeOwned + 'static>(
+    extra: &[(&str, f64)],
+) -> Box<dyn PolicyConfig> {
+    let mut t = toml::Table::new();
+    t.insert("alpha".into(), PAPER_ALPHA.into());
+    t.insert("pretrain".into(), true.into());
+    for (k, v) in extra {
+        t.insert((*k).into(), (*v).into());
+    }
+    let cfg: T = toml::Value::Table(t)
+        .try_into()
+        .expect("the paper's policy parameters are a valid config of the policy's type");
+    Box::new(cfg)
+}
+
+fn paper_methods() -> Vec<MethodConfig> {
+    vec![
+        MethodConfig::new("LinUCB", paper_policy::<hil_policies::LinUcbConfig>(&[])),
+        MethodConfig::new(
+            "AlwaysQuery",
+            paper_policy::<hil_policies::AlwaysQueryConfig>(&[]),
+        ),
+        MethodConfig::new(
+            "LinUCB-QG",
+            paper_policy::<hil_policies::LinUcbQgConfig>(&[("w", PAPER_W)]),
+        ),
+    ]
+}
+
+/// `[session]`: the given keys over the paper's session.
+fn session_over_paper<'de, D: Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<SessionSettings, D::Error> {
+    let given = toml::Table::deserialize(d)?;
+    let mut merged = toml::Table::try_from(paper_session()).map_err(D::Error::custom)?;
+    merged.extend(given);
+    SessionSettings::deserialize(toml::Value::Table(merged))
+        .map_err(|e| D::Error::custom(e.message().trim()))
+}
+
+impl Default for UserStudyConfig {
+    fn default() -> Self {
+        Self::paper()
+    }
+}
+
+impl UserStudyConfig {
+    /// The paper's real-robot protocol, in the MuJoCo scene: a plate of
+    /// banana, baby carrot and cantaloupe (`kinova_feeding`, 2 simulated
+    /// pretraining attempts per food and action); N_att = 3, WL_0 = 0.5;
+    /// LinUCB, AlwaysQuery and LinUCB-QG (α = 0.5, w = 0.3, pretrained);
+    /// the bundled `f12_real` workload model; a perfect `simulated_expert`
+    /// answering; 2 repetitions; seed 7. `examples/configs/user-study.toml`
+    /// is this config written out.
+    ///
+    /// ```
+    /// let cfg = hil_experiments::user_study::UserStudyConfig::paper();
+    /// assert_eq!((cfg.repetitions, cfg.session.n_att, cfg.seed), (2, 3, 7));
+    /// ```
+    pub fn paper() -> Self {
+        Self {
+            plugins: Vec::new(),
+            seed: paper_seed(),
+            repetitions: paper_repetitions(),
+            session: paper_session(),
+            environment: paper_environment(),
+            workload: paper_workload(),
+            channel: paper_channel(),
+            methods: paper_methods(),
+        }
+    }
+
+    /// Reads and validates a study file (see [`UserStudyConfig::parse`]).
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
+        Ok(Self::parse(&text, path)?)
+    }
+
+    /// Parses and validates study TOML; `path` names the file in errors and
+    /// is where the `plugins` it lists are resolved from. The plugins are
+    /// loaded first, so that plugin types are usable wherever built-in ones
+    /// are. Every error names the file, line and field.
+    pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
+        // typetag finds a built-in type only if its crate is linked into the
+        // program; a program that names them only in files would drop them.
+        hil_policies::link();
+        hil_workload::link();
+        hil_envs::link();
+        hil_kinova_mujoco::link();
+        hil_channels::link();
+        load_plugins(text, path)?;
+        let cfg: Self = parse_toml(text, path)?;
+        cfg.validate_in(text, path)?;
+        Ok(cfg)
+    }
+
+    /// Checks what the types alone do not: repetitions ≥ 1, at least one
+    /// method, unique non-empty labels, valid session settings.
+    pub fn validate(&self) -> Result<()> {
+        self.validate_in("", Path::new("<config>"))
+            .map_err(|e| HilError::invalid_input(e.field.unwrap_or_default(), e.message))
+    }
+
+    fn validate_in(&self, text: &str, path: &Path) -> std::result::Result<(), ConfigError> {
+        let at = |key: &[&str], msg: &str| ConfigError::at_key(text, path, key, msg.to_string());
+        self.session
+            .validate()
+            .map_err(|e| ConfigError::at_key(text, path, &["session"], e.to_string()))?;
+        if self.repetitions == 0 {
+            return Err(at(&["repetitions"], "must be at least 1"));
+        }
+        if self.methods.is_empty() {
+            return Err(at(&["methods"], "name at least one method"));
+        }
+        let mut seen = HashSet::new();
+        for (i, m) in self.methods.iter().enumerate() {
+            if m.label.trim().is_empty() {
+                return Err(located_label(text, path, i, "must not be empty"));
+            }
+            if !seen.insert(m.label.as_str()) {
+                let msg = format!("`{}` names two methods; labels must be unique", m.label);
+                return Err(located_label(text, path, i, &msg));
+            }
+        }
+        Ok(())
+    }
+
+    /// The method labels, in the order of the first repetition.
+    pub fn labels(&self) -> Vec<&str> {
+        self.methods.iter().map(|m| m.label.as_str()).collect()
+    }
+
+    /// The build context of this study: paths resolve against `base_dir`
+    /// (the file's directory), components see the study's seed.
+    pub fn context(&self, base_dir: &Path) -> BuildContext {
+        BuildContext::new(base_dir, self.seed)
+    }
+
+    /// Builds the environment from `[environment]`.
+    pub fn build_environment(&self, base_dir: &Path) -> Result<Box<dyn hil_core::Environment>> {
+        self.environment.build(&self.context(base_dir))
+    }
+
+    /// The config as TOML (components with their `type`), e.g. to record
+    /// beside results.
+    pub fn to_toml(&self) -> Result<String> {
+        toml::to_string(self).map_err(|e| HilError::serde("user-study config", e))
+    }
+}
+
+/// An error at the label of method `index` (0-based): the line of the
+/// `index`-th `[[methods]]` entry's `label` when the file writes methods as
+/// an array of tables, else wherever [`ConfigError::at_key`] finds `label`.
+fn located_label(text: &str, path: &Path, index: usize, message: &str) -> ConfigError {
+    let mut err = ConfigError::at_key(text, path, &["methods", "label"], message.to_string());
+    let mut entry = None;
+    for (n, line) in text.lines().enumerate() {
+        let l = line.trim_start();
+        if l.starts_with("[[") {
+            let header = l.trim_start_matches("[[").split("]]").next().unwrap_or("");
+            entry = if header.trim() == "methods" {
+                Some(entry.map_or(0, |e: usize| e + 1))
+            } else {
+                None
+            };
+        } else if l.starts_with('[') {
+            // A sub-table such as `[methods.policy]` belongs to the entry;
+            // any other table ends it.
+            if !l.starts_with("[methods.") {
+                entry = None;
+            }
+        } else if entry == Some(index)
+            && l.split('=').next().map(str::trim) == Some("label")
+            && l.contains('=')
+        {
+            err.line = n + 1;
+            err.column = 1;
+            break;
+        }
+    }
+    err.field = Some(format!("methods[{index}].label"));
+    err
+}

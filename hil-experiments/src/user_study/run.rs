@@ -1,0 +1,413 @@
+//! Running the study: the plate schedule, the built methods, the results.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use hil_core::metrics::mean_std;
+use hil_core::session::splitmix;
+use hil_core::{
+    BuildContext, Environment, EpisodeReport, Policy, Result, Session, SessionObserver,
+    WorkloadModel,
+};
+use serde::{Deserialize, Serialize};
+
+use super::config::UserStudyConfig;
+
+/// The method order of repetition `rep` (0-based) over `n` methods, as
+/// indices into the study's methods. Even repetitions rotate the first
+/// order by `rep / 2`; odd ones reverse the repetition before them. Every
+/// pair of repetitions therefore gives every method the same mean
+/// position, and `2n` repetitions put every method in every position
+/// exactly twice, so learning or fatigue across plates does not favour a
+/// method. For three methods the orders are ABC, CBA, BCA, ACB, CAB, BAC.
+///
+/// ```
+/// use hil_experiments::user_study::method_order;
+/// assert_eq!(method_order(0, 3), [0, 1, 2]);
+/// assert_eq!(method_order(1, 3), [2, 1, 0]);
+/// ```
+pub fn method_order(rep: usize, n: usize) -> Vec<usize> {
+    if n == 0 {
+        return Vec::new();
+    }
+    let shift = (rep / 2) % n;
+    let mut order: Vec<usize> = (0..n).map(|i| (i + shift) % n).collect();
+    if rep % 2 == 1 {
+        order.reverse();
+    }
+    order
+}
+
+/// One plate of the study: which method the participant meets, when.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Plate {
+    /// Index of the method in the config's `methods`.
+    pub method: usize,
+    /// The method's label.
+    pub label: String,
+    /// Repetition, 1-based.
+    pub repetition: usize,
+    /// Position of the plate within its repetition, 1-based.
+    pub position: usize,
+    /// The plate's episode seed.
+    pub seed: u64,
+}
+
+/// The result of one plate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlateResult {
+    /// The method's label.
+    pub method: String,
+    /// Repetition, 1-based.
+    pub repetition: usize,
+    /// Position within the repetition, 1-based.
+    pub position: usize,
+    /// Mean expected task reward per step.
+    pub r_task_avg: f64,
+    /// Items fed successfully.
+    pub n_success: usize,
+    /// Queries asked.
+    pub n_q: usize,
+    /// Steps (attempts) taken.
+    pub n_steps: usize,
+}
+
+/// A mean over plates with its standard error.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MeanSem {
+    /// The mean.
+    pub mean: f64,
+    /// Its standard error (sample standard deviation / √n); `None` with
+    /// fewer than two values, where it is undefined.
+    pub sem: Option<f64>,
+}
+
+/// Mean and standard error of `xs` (the population standard deviation of
+/// [`hil_core::metrics::mean_std`], rescaled to the sample one, over √n).
+///
+/// ```
+/// use hil_experiments::user_study::mean_sem;
+/// let m = mean_sem(&[1.0, 3.0]);
+/// assert_eq!((m.mean, m.sem), (2.0, Some(1.0)));
+/// assert_eq!(mean_sem(&[5.0]).sem, None);
+/// ```
+pub fn mean_sem(xs: &[f64]) -> MeanSem {
+    let (mean, std) = mean_std(xs);
+    let n = xs.len() as f64;
+    MeanSem {
+        mean,
+        sem: (xs.len() >= 2).then(|| std / (n - 1.0).sqrt()),
+    }
+}
+
+/// One method's figures, mean ± standard error over its plates.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MethodSummary {
+    /// The method's label.
+    pub method: String,
+    /// Plates the figures are over.
+    pub plates: usize,
+    /// Mean r_task_avg per plate.
+    pub r_task_avg: f64,
+    /// Its standard error.
+    pub r_task_avg_sem: Option<f64>,
+    /// Mean items fed per plate.
+    pub n_success_per_plate: f64,
+    /// Its standard error.
+    pub n_success_per_plate_sem: Option<f64>,
+    /// Mean queries per plate.
+    pub n_q_per_plate: f64,
+    /// Its standard error.
+    pub n_q_per_plate_sem: Option<f64>,
+}
+
+impl MethodSummary {
+    fn over(method: &str, plates: &[&PlateResult]) -> Self {
+        let col =
+            |f: fn(&PlateResult) -> f64| mean_sem(&plates.iter().map(|p| f(p)).collect::<Vec<_>>());
+        let r = col(|p| p.r_task_avg);
+        let s = col(|p| p.n_success as f64);
+        let q = col(|p| p.n_q as f64);
+        Self {
+            method: method.to_string(),
+            plates: plates.len(),
+            r_task_avg: r.mean,
+            r_task_avg_sem: r.sem,
+            n_success_per_plate: s.mean,
+            n_success_per_plate_sem: s.sem,
+            n_q_per_plate: q.mean,
+            n_q_per_plate_sem: q.sem,
+        }
+    }
+}
+
+/// The protocol a result was produced under.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Protocol {
+    /// The environment's name.
+    pub environment: String,
+    /// The item labels met, in order of first appearance.
+    pub foods: Vec<String>,
+    /// The methods, in the order of the first repetition.
+    pub methods: Vec<String>,
+    /// Attempts per item.
+    pub n_att: u32,
+    /// Initial workload.
+    pub wl0: f64,
+    /// Repetitions of every method.
+    pub repetitions: usize,
+    /// Master seed.
+    pub seed: u64,
+}
+
+/// Everything a study run produced, plain and serialisable.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct UserStudyResult {
+    /// How it was run.
+    pub protocol: Protocol,
+    /// Every plate, in the order run.
+    pub plates: Vec<PlateResult>,
+    /// Per method, in the config's order.
+    pub methods: Vec<MethodSummary>,
+}
+
+/// Runs one plate's episode on the environment it is given, with extra
+/// observers; the callback of [`UserStudy::run_with`] calls it, possibly
+/// around a wrapper of the environment.
+pub type Episode<'a> =
+    dyn FnMut(&mut dyn Environment, &mut [&mut dyn SessionObserver]) -> Result<EpisodeReport> + 'a;
+
+/// A built study: every method's policy and the workload model, ready to
+/// run plates on an environment built from the same config.
+pub struct UserStudy<'c> {
+    config: &'c UserStudyConfig,
+    ctx: BuildContext,
+    policies: Vec<Box<dyn Policy>>,
+    workload: Arc<dyn WorkloadModel>,
+}
+
+impl std::fmt::Debug for UserStudy<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("UserStudy")
+            .field("methods", &self.config.labels())
+            .field("workload", &self.workload.name())
+            .finish()
+    }
+}
+
+impl UserStudyConfig {
+    /// Builds the methods' policies and the workload model for `environment`
+    /// (built from this config's `[environment]`, e.g. by
+    /// [`UserStudyConfig::build_environment`]): the policies see its action
+    /// space, context dimension and the pretraining data `[environment]`
+    /// offers, as in an experiment file.
+    pub fn prepare(&self, base_dir: &Path, environment: &dyn Environment) -> Result<UserStudy<'_>> {
+        self.validate()?;
+        let mut ctx = self.context(base_dir);
+        ctx.describe_environment(self.environment.as_ref(), environment)?;
+        let workload = self.workload.build(&ctx)?;
+        let policies = self
+            .methods
+            .iter()
+            .map(|m| {
+                m.policy.build(&ctx).map_err(|e| {
+                    hil_core::HilError::invalid_input(
+                        format!("method `{}`", m.label),
+                        e.to_string(),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(UserStudy {
+            config: self,
+            ctx,
+            policies,
+            workload,
+        })
+    }
+
+    /// Builds the environment once, then runs every plate on it, calling
+    /// `on_plate` after each.
+    ///
+    /// ```
+    /// use hil_experiments::user_study::UserStudyConfig;
+    /// // A cheap environment: the bundled synthetic food dataset.
+    /// let cfg = UserStudyConfig::parse(
+    ///     r#"
+    ///     repetitions = 1
+    ///     [environment]
+    ///     type = "food_replay"
+    ///     foods = ["banana", "carrot"]
+    ///     pretrain_foods = ["apple", "kiwi"]
+    ///     items_per_episode = 3
+    ///     "#,
+    ///     "study.toml".as_ref(),
+    /// )
+    /// .unwrap();
+    /// let result = cfg.run(".".as_ref(), |_| {}).unwrap();
+    /// assert_eq!(result.plates.len(), 3);
+    /// assert_eq!(result.methods[2].method, "LinUCB-QG");
+    /// ```
+    pub fn run(
+        &self,
+        base_dir: &Path,
+        mut on_plate: impl FnMut(&PlateResult),
+    ) -> Result<UserStudyResult> {
+        let mut env = self.build_environment(base_dir)?;
+        let mut study = self.prepare(base_dir, env.as_ref())?;
+        study.run_with(
+            env.as_mut(),
+            |_, env, episode| episode(env, &mut []),
+            |p| on_plate(p),
+        )
+    }
+}
+
+impl UserStudy<'_> {
+    /// Every plate in the order it is run: repetitions one after another,
+    /// the methods of each in [`method_order`].
+    pub fn schedule(&self) -> Vec<Plate> {
+        let n = self.config.methods.len();
+        (0..self.config.repetitions)
+            .flat_map(|rep| {
+                method_order(rep, n)
+                    .into_iter()
+                    .enumerate()
+                    .map(move |(position, method)| (rep, position, method))
+            })
+            .map(|(rep, position, method)| Plate {
+                method,
+                label: self.config.methods[method].label.clone(),
+                repetition: rep + 1,
+                position: position + 1,
+                seed: splitmix(self.config.seed, (rep * n + position) as u64),
+            })
+            .collect()
+    }
+
+    /// Runs every plate on `env`. For each plate, `each` receives the plate,
+    /// the environment and the [`Episode`] to run on it: call it on `env`
+    /// itself, or on a wrapper (e.g. one that records keyframes), with any
+    /// observers. `on_plate` sees each result as it comes. A policy keeps
+    /// what it learnt on one plate for its next; a fresh channel answers
+    /// every plate.
+    pub fn run_with<E: ?Sized>(
+        &mut self,
+        env: &mut E,
+        mut each: impl FnMut(&Plate, &mut E, &mut Episode<'_>) -> Result<EpisodeReport>,
+        mut on_plate: impl FnMut(&PlateResult),
+    ) -> Result<UserStudyResult> {
+        let cfg = self.config;
+        let mut plates = Vec::new();
+        let mut foods: Vec<String> = Vec::new();
+        let mut env_name = String::new();
+        for plate in self.schedule() {
+            let mut channel = cfg.channel.build(&self.ctx)?;
+            let policy = self.policies[plate.method].as_mut();
+            let workload = Arc::clone(&self.workload);
+            let mut episode =
+                |env: &mut dyn Environment, observers: &mut [&mut dyn SessionObserver]| {
+                    env_name = env.name().to_string();
+                    Session {
+                        settings: cfg.session.clone(),
+                        environment: env,
+                        policy: &mut *policy,
+                        channel: channel.as_mut(),
+                        workload: Arc::clone(&workload),
+                        forecast: None,
+                    }
+                    .run_episode(plate.seed, observers)
+                };
+            let report = each(&plate, env, &mut episode)?;
+            for e in &report.events {
+                if !foods.contains(&e.step.item_label) {
+                    foods.push(e.step.item_label.clone());
+                }
+            }
+            let m = &report.metrics;
+            let result = PlateResult {
+                method: plate.label.clone(),
+                repetition: plate.repetition,
+                position: plate.position,
+                r_task_avg: m.r_task_avg,
+                n_success: m.n_success,
+                n_q: m.n_q,
+                n_steps: m.n_steps,
+            };
+            on_plate(&result);
+            plates.push(result);
+        }
+        let methods = cfg
+            .labels()
+            .into_iter()
+            .map(|label| {
+                let mine: Vec<&PlateResult> = plates.iter().filter(|p| p.method == label).collect();
+                MethodSummary::over(label, &mine)
+            })
+            .collect();
+        Ok(UserStudyResult {
+            protocol: Protocol {
+                environment: env_name,
+                foods,
+                methods: cfg.labels().into_iter().map(String::from).collect(),
+                n_att: cfg.session.n_att,
+                wl0: cfg.session.wl0,
+                repetitions: cfg.repetitions,
+                seed: cfg.seed,
+            },
+            plates,
+            methods,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn method_order_is_counterbalanced() {
+        for n in 1..=6 {
+            // Every pair of repetitions: equal mean position for every method.
+            let mut sum = vec![0; n];
+            for rep in 0..2 {
+                for (p, &m) in method_order(rep, n).iter().enumerate() {
+                    sum[m] += p;
+                }
+            }
+            assert!(sum.iter().all(|&s| s == n - 1), "n = {n}: {sum:?}");
+            // 2n repetitions: every method twice in every position.
+            let mut pos = vec![vec![0; n]; n];
+            for rep in 0..2 * n {
+                let o = method_order(rep, n);
+                let mut seen = o.clone();
+                seen.sort();
+                assert_eq!(seen, (0..n).collect::<Vec<_>>());
+                for (p, &m) in o.iter().enumerate() {
+                    pos[m][p] += 1;
+                }
+            }
+            assert!(pos.iter().flatten().all(|&c| c == 2), "n = {n}: {pos:?}");
+        }
+        // The paper's three methods: the six orders, in the order used so far.
+        let orders: Vec<Vec<usize>> = (0..6).map(|r| method_order(r, 3)).collect();
+        assert_eq!(
+            orders,
+            [
+                [0, 1, 2],
+                [2, 1, 0],
+                [1, 2, 0],
+                [0, 2, 1],
+                [2, 0, 1],
+                [1, 0, 2]
+            ]
+        );
+    }
+
+    #[test]
+    fn mean_sem_of_constant_is_zero() {
+        let m = mean_sem(&[2.0, 2.0, 2.0]);
+        assert_eq!((m.mean, m.sem), (2.0, Some(0.0)));
+        assert!(mean_sem(&[]).mean.is_nan());
+    }
+}

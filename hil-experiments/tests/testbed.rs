@@ -1,65 +1,18 @@
-//! The protocol end to end on a small dataset, with small real policies
-//! written here (the LinUCB family lives in hil-policies, which hil-envs does
-//! not depend on) and hil-core's counting workload model.
+//! The simulated-testbed protocol end to end on a small dataset, with the
+//! paper's real policies (hil-policies) and hil-core's counting workload
+//! model.
 
 use std::sync::Arc;
 
 use hil_core::testing::fixtures::CountingWorkload;
-use hil_core::{ArmId, Decision, DecisionInput, Feedback, Policy, QueryKind, Result};
 use hil_envs::generate::SyntheticFoods;
-use hil_envs::protocol::{
-    CrossSetting, Family, NamedModel, PolicySpec, Protocol, ProtocolSettings,
-};
-use hil_envs::results::aggregate;
 use hil_envs::{FoodDataset, FoodSplit};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-
-/// Acts with arm 0 unless told to query: AlwaysQuery always, ExpDecay with
-/// probability e^{−cN} at an item's first attempt, QG when
-/// w · WL_if_queried < 1.
-struct Simple {
-    spec: PolicySpec,
-    dim: usize,
-    rng: ChaCha8Rng,
-}
-
-impl Policy for Simple {
-    fn name(&self) -> &str {
-        "simple"
-    }
-    fn n_arms(&self) -> usize {
-        6
-    }
-    fn dim(&self) -> usize {
-        self.dim
-    }
-    fn seed(&mut self, seed: u64) {
-        self.rng = ChaCha8Rng::seed_from_u64(seed);
-    }
-    fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
-        let k = QueryKind::default();
-        let query = match self.spec {
-            PolicySpec::Linucb => false,
-            PolicySpec::AlwaysQuery => true,
-            PolicySpec::LinucbExpDecay { c } => {
-                input.attempt == 0
-                    && self.rng.random::<f64>() < (-c * input.items_seen as f64).exp()
-            }
-            PolicySpec::LinucbQg { w } => w * input.workload.if_queried(k)? < 1.0,
-        };
-        Ok(if query {
-            Decision::query(k, ArmId(0))
-        } else {
-            Decision::act(ArmId(0))
-        })
-    }
-    fn observe(&mut self, _f: &Feedback<'_>) -> Result<()> {
-        Ok(())
-    }
-}
+use hil_experiments::results::aggregate;
+use hil_experiments::testbed::{CrossSetting, Phase, RunKey, RunRecord};
+use hil_experiments::{NamedModel, Protocol, ProtocolSettings};
 
 fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
+    hil_policies::link();
     let ds = Arc::new(
         SyntheticFoods {
             dim: 224,
@@ -70,17 +23,20 @@ fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
         .unwrap()
         .dataset,
     );
-    let settings = ProtocolSettings {
+    let mut settings = ProtocolSettings {
         n_policy_seeds: 3,
         w_tasks: vec![0.2, 0.9],
-        qg_w: vec![0.5, 1.5, 3.0],
-        exp_decay_c: vec![0.0, 2.0],
         cross: vec![CrossSetting {
+            method: "LinUCB-QG".into(),
             decide: "slow".into(),
             score: "fast".into(),
         }],
         ..ProtocolSettings::paper()
     };
+    settings.methods[2].tune.insert("c".into(), vec![0.0, 2.0]);
+    settings.methods[3].tune.insert("w".into(), vec![0.5, 1.5, 3.0]);
+    settings.figures.model = "fast".into();
+    settings.figures.w_task = 0.9;
     let models = vec![
         NamedModel {
             name: "slow".into(),
@@ -94,42 +50,42 @@ fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
     (ds, settings, models)
 }
 
-fn factory(spec: &PolicySpec) -> Result<Box<dyn Policy>> {
-    Ok(Box::new(Simple {
-        spec: *spec,
-        dim: 224,
-        rng: ChaCha8Rng::seed_from_u64(0),
-    }))
+fn run_all(p: &Protocol, threads: usize) -> Vec<RunRecord> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| p.run_all(&|_, _| {}))
+        .unwrap()
 }
 
 #[test]
 fn protocol_runs_selects_on_validation_and_is_deterministic() {
     let (ds, settings, models) = setup();
-    let p = Protocol {
-        settings: settings.clone(),
-        dataset: ds.clone(),
-        models: models.clone(),
-        factory: &factory,
-    };
-    // 2 phases × 3 seeds × (LinUCB + AQ + 2 c × 3 policy seeds + 3 w × 2 models).
-    assert_eq!(p.jobs().len(), 2 * 3 * (1 + 1 + 6 + 6));
+    let p = Protocol::new(settings.clone(), ds.clone(), models.clone());
+    // What each method needs comes from its config: 2 phases × 3 seeds ×
+    // (LinUCB + AQ + 2 c × 3 policy seeds + 3 w × 2 deciding models).
+    assert_eq!(p.jobs().unwrap().len(), 2 * 3 * (1 + 1 + 6 + 6));
     let seen = std::sync::atomic::AtomicUsize::new(0);
     let recs = p
-        .run_all(2, &|_, _| {
+        .run_all(&|_, _| {
             seen.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         })
         .unwrap();
     assert_eq!(seen.into_inner(), recs.len());
-    let recs1 = p.run_all(1, &|_, _| {}).unwrap();
-    let json = |r: &[hil_envs::protocol::RunRecord]| serde_json::to_string(r).unwrap();
-    assert_eq!(json(&recs), json(&recs1), "thread count changed results");
+    let json = |r: &[RunRecord]| serde_json::to_string(r).unwrap();
+    assert_eq!(
+        json(&run_all(&p, 1)),
+        json(&run_all(&p, 2)),
+        "thread count changed results"
+    );
 
     let res = aggregate(&settings, &models, &recs, "test data").unwrap();
     assert_eq!(res.rows.len(), 2 * 2 * 4);
     for r in &res.rows {
-        match r.policy {
-            Family::AlwaysQuery => assert_eq!(r.test.f_q.mean, 1.0),
-            Family::Linucb => {
+        match r.method.as_str() {
+            "AlwaysQuery" => assert_eq!(r.test.f_q.mean, 1.0),
+            "LinUCB" => {
                 assert_eq!(r.test.f_q.mean, 0.0);
                 // No queries: the counting model stays at WL_0.
                 assert_eq!(r.test.delta_wl.mean, 0.0);
@@ -150,111 +106,126 @@ fn protocol_runs_selects_on_validation_and_is_deterministic() {
         let chosen = s.candidates.iter().find(|c| c.0 == s.chosen).unwrap().1;
         assert_eq!(chosen, best);
     }
-    // Under the fast model at w_task = 0.2 workload dominates: QG picks a
-    // large w (fewer queries) and queries less than under w_task = 0.9.
-    let lo = res.row("fast", 0.2, Family::LinucbQg).unwrap();
-    let hi = res.row("fast", 0.9, Family::LinucbQg).unwrap();
-    assert!(lo.test.f_q.mean <= hi.test.f_q.mean);
-    // Cross row: QG decided with `slow`, w chosen as in the slow row, scored with `fast`.
+    // Cross row: QG decided with `slow`, w chosen as in the slow row, scored
+    // with `fast` through hil-core's rescoring.
     let c = &res.cross[0];
-    let slow = res.row("slow", 0.4, Family::LinucbQg);
-    assert!(slow.is_none()); // 0.4 is not in w_tasks; selection still ran for the cross row
+    assert!(res.row("slow", 0.4, "LinUCB-QG").is_none()); // selection still ran
     assert_eq!(c.test.n_runs, 3);
-    let dir = std::env::temp_dir().join(format!("hil-envs-out-{}", std::process::id()));
-    let w = hil_envs::output::write_outputs(
-        &dir,
-        &res,
-        &recs,
-        &models,
-        "fast",
-        0.9,
-        &Default::default(),
-    )
-    .unwrap();
+    let decided: Vec<&RunRecord> = recs
+        .iter()
+        .filter(|r| {
+            r.key.phase == Phase::Test
+                && r.key.method == 3
+                && r.key.decide_model == Some(0)
+                && r.key.point.as_ref().map(|p| p.1) == c.selected.as_ref().map(|h| h.value)
+        })
+        .collect();
+    let rescored: f64 = decided
+        .iter()
+        .map(|r| r.metrics.rescored(models[1].model.as_ref()).unwrap().delta_wl)
+        .sum::<f64>()
+        / decided.len() as f64;
+    assert!((rescored - c.test.delta_wl.mean).abs() < 1e-12);
+
+    let dir = std::env::temp_dir().join(format!("hil-experiments-out-{}", std::process::id()));
+    let w = hil_experiments::output::write_outputs(&dir, &res, &recs, &models, &Default::default())
+        .unwrap();
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&w.results).unwrap()).unwrap();
     assert_eq!(v["rows"].as_array().unwrap().len(), 16);
     assert!(v["provenance"].is_string() && v["timing"].is_object());
     assert_eq!(w.figures.len(), 2);
     std::fs::remove_dir_all(&dir).unwrap();
-    let md = hil_envs::report::tables_markdown(&res, Some(1.0));
+    let md = hil_experiments::report::tables_markdown(&res, Some(1.0)).unwrap();
     assert!(md.contains("synthetic") || md.contains("test data"));
     assert!(md.contains("Cross-data"));
 }
 
 #[test]
-fn bad_settings_are_errors() {
+fn bad_settings_are_errors_that_name_the_field() {
+    use hil_core::HilError;
     let (ds, mut settings, models) = setup();
     settings.split = FoodSplit {
         test: vec![],
         ..FoodSplit::paper()
     };
-    let p = Protocol {
-        settings,
-        dataset: ds.clone(),
-        models: models.clone(),
-        factory: &factory,
-    };
-    let e = p.run_all(1, &|_, _| {}).unwrap_err().to_string();
+    let p = Protocol::new(settings, ds.clone(), models.clone());
+    let e = p.run_all(&|_, _| {}).unwrap_err().to_string();
     assert!(e.contains("split.test"), "{e}");
+
     let (ds, mut settings, models) = setup();
     settings.cross[0].score = "nope".into();
-    let p = Protocol {
-        settings,
-        dataset: ds,
-        models,
-        factory: &factory,
-    };
-    assert!(
-        p.run_all(1, &|_, _| {})
-            .unwrap_err()
-            .to_string()
-            .contains("nope")
-    );
+    let e = settings.validate(&ds, &models).unwrap_err();
+    assert!(matches!(e, HilError::InvalidParameter { .. }), "{e:?}");
+
+    // A cross-data method must read the workload forecast.
+    let (ds, mut settings, models) = setup();
+    settings.cross[0].method = "LinUCB".into();
+    let e = settings.validate(&ds, &models).unwrap_err();
+    assert!(matches!(&e, HilError::InvalidParameter { name, .. } if name == "cross.method"));
+
+    // Two tuned hyperparameters, duplicate labels, a grid value the policy refuses.
+    let (ds, mut settings, models) = setup();
+    settings.methods[3].tune.insert("alpha".into(), vec![0.1]);
+    let e = settings.validate(&ds, &models).unwrap_err();
+    assert!(matches!(&e, HilError::InvalidParameter { name, .. } if name == "methods[3].tune"));
+    let (ds, mut settings, models) = setup();
+    settings.methods[1].label = "LinUCB".into();
+    let e = settings.validate(&ds, &models).unwrap_err();
+    assert!(matches!(&e, HilError::InvalidParameter { name, .. } if name == "methods[1].label"));
+    let (ds, mut settings, models) = setup();
+    settings.methods[3].tune.insert("w".into(), vec![-1.0]);
+    assert!(settings.validate(&ds, &models).is_err());
 }
 
 #[test]
 fn plots_render_runs() {
     let (ds, settings, models) = setup();
-    let p = Protocol {
-        settings,
-        dataset: ds,
-        models: models.clone(),
-        factory: &factory,
-    };
+    let p = Protocol::new(settings, ds, models.clone());
+    let ctx = p.build_context().unwrap();
     let rec = p
-        .run_one(&hil_envs::protocol::RunKey {
-            phase: hil_envs::protocol::Phase::Test,
-            spec: PolicySpec::AlwaysQuery,
-            decide_model: None,
-            seed: 0,
-            policy_seed: 0,
-        })
+        .run_one(
+            &RunKey {
+                phase: Phase::Test,
+                method: 1,
+                point: None,
+                decide_model: None,
+                seed: 0,
+                policy_seed: 0,
+            },
+            &ctx,
+        )
         .unwrap();
     let m = models[1].model.as_ref();
-    let svg = hil_envs::plot::rollout_svg(&rec, m, 0.5, "t", "synthetic").unwrap();
+    let svg = hil_experiments::plot::rollout_svg(&rec, m, "t", "synthetic").unwrap();
     assert!(
         svg.starts_with("<svg") && svg.contains("<circle") && svg.trim_end().ends_with("</svg>")
     );
     assert_eq!(
         svg.matches("r=\"5\" fill=\"none\" stroke=\"red\"").count(),
-        rec.queries.len()
+        rec.metrics.queries.len()
     );
     let svg =
-        hil_envs::plot::workload_comparison_svg(&[("a", &rec), ("b", &rec)], m, 0.5, "n").unwrap();
+        hil_experiments::plot::workload_comparison_svg(&[("a", &rec), ("b", &rec)], m, "n")
+            .unwrap();
     assert_eq!(svg.matches("<polyline").count(), 2);
 }
 
 #[test]
 fn paper_protocol_config_file_matches_the_built_in_settings() {
+    hil_policies::link();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/configs/paper-protocol.toml");
+    assert_eq!(
+        ProtocolSettings::load(&path).unwrap(),
+        ProtocolSettings::paper()
+    );
     let text = std::fs::read_to_string(&path).unwrap();
-    let parsed: ProtocolSettings = hil_core::config::parse_toml(&text, &path).unwrap();
-    assert_eq!(parsed, ProtocolSettings::paper());
     let bad = text.replace("n_seeds = 3", "n_seeds = 3\nn_seed = 2");
-    let e = hil_core::config::parse_toml::<ProtocolSettings>(&bad, &path)
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("n_seed"), "{e}");
+    let e = hil_core::config::parse_toml::<ProtocolSettings>(&bad, &path).unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("n_seed"));
+    // A method's policy table is checked as a policy config when parsed.
+    let bad = text.replace("w = 1.0 }", "w = 1.0, omega = 2.0 }");
+    let e = hil_core::config::parse_toml::<ProtocolSettings>(&bad, &path).unwrap_err();
+    assert!(e.message.contains("omega"), "{e}");
 }

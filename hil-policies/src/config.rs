@@ -116,6 +116,9 @@ pub trait RuleConfig:
 {
     /// The rule the config builds.
     type Rule: QueryRule;
+    /// The struct's field names, for the "expected one of" list of an
+    /// unknown-field error (kept in step with the struct by a test).
+    const FIELDS: &'static [&'static str];
     /// Whether the policy ever asks, so that `query_kind` is one of its keys.
     const ASKS: bool;
     /// Whether its decisions read the workload forecast.
@@ -165,6 +168,25 @@ fn take(table: &mut toml::Table, keys: &[&str]) -> toml::Table {
         .collect()
 }
 
+/// The key an "unknown field `key`" message names.
+fn unknown_field(message: &str) -> Option<&str> {
+    let rest = message.strip_prefix("unknown field `")?;
+    rest.split('`').next()
+}
+
+/// Every key a config with own fields `F` accepts, as serde lists them.
+fn expected<F: RuleConfig>() -> String {
+    let asks = F::ASKS.then_some(QUERY_KIND);
+    let keys: Vec<String> = ESTIMATOR_KEYS
+        .iter()
+        .copied()
+        .chain(asks)
+        .chain(F::FIELDS.iter().copied())
+        .map(|k| format!("`{k}`"))
+        .collect();
+    keys.join(", ")
+}
+
 impl<'de, F: RuleConfig> Deserialize<'de> for LinearPolicyConfig<F> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         // The messages are serde's own ("unknown field `x`", "missing field
@@ -184,7 +206,16 @@ impl<'de, F: RuleConfig> Deserialize<'de> for LinearPolicyConfig<F> {
             Some(v) => QueryKind::deserialize(v).map_err(de)?,
             None => QueryKind::default(),
         };
-        let rule = F::deserialize(toml::Value::Table(rest)).map_err(de)?;
+        let rule = F::deserialize(toml::Value::Table(rest)).map_err(|e| {
+            // `F` alone would list only its own fields as expected.
+            match unknown_field(e.message()) {
+                Some(key) => D::Error::custom(format!(
+                    "unknown field `{key}`, expected one of {}",
+                    expected::<F>()
+                )),
+                None => de(e),
+            }
+        })?;
         let common = EstimatorConfig::deserialize(toml::Value::Table(shared)).map_err(de)?;
         Ok(Self {
             common,
@@ -263,5 +294,29 @@ mod tests {
         keys.sort_unstable();
         expected.sort_unstable();
         assert_eq!(keys, expected);
+    }
+
+    /// The keys a fields struct writes (all set) are its `FIELDS`.
+    fn assert_fields<F: RuleConfig>(all_set: F) {
+        let t = match toml::Value::try_from(&all_set).unwrap() {
+            toml::Value::Table(t) => t,
+            other => panic!("{other:?}"),
+        };
+        let mut keys: Vec<&str> = t.keys().map(String::as_str).collect();
+        let mut fields = F::FIELDS.to_vec();
+        keys.sort_unstable();
+        fields.sort_unstable();
+        assert_eq!(keys, fields, "{all_set:?}");
+    }
+
+    #[test]
+    fn rule_fields_are_listed() {
+        assert_fields(crate::LinUcbFields {});
+        assert_fields(crate::AlwaysQueryFields {});
+        assert_fields(crate::LinUcbExpDecayFields {
+            c: 0.1,
+            seed: Some(1),
+        });
+        assert_fields(crate::LinUcbQgFields { w: 0.1 });
     }
 }

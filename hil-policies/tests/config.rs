@@ -43,6 +43,8 @@ fn unknown_fields_are_rejected_and_named() {
             let e = parse(&format!("{}{bad} = 1.0\n", minimal(ty))).unwrap_err();
             assert_eq!(e.field.as_deref(), Some(&*format!("policy.{bad}")), "{e}");
             assert!(e.message.contains("unknown field"), "{e}");
+            // The hint lists the shared keys too, not only the policy's own.
+            assert!(e.message.contains("`lambda`"), "{e}");
         }
     }
     // LinUCB never asks, so `query_kind` is not one of its keys.

@@ -24,6 +24,7 @@ pub struct AlwaysQueryFields {}
 
 impl RuleConfig for AlwaysQueryFields {
     type Rule = AlwaysQueryParams;
+    const FIELDS: &'static [&'static str] = &[];
     const ASKS: bool = true;
     const USES_WORKLOAD_FORECAST: bool = false;
     const STOCHASTIC: bool = false;

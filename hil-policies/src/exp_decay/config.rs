@@ -31,6 +31,7 @@ pub struct LinUcbExpDecayFields {
 
 impl RuleConfig for LinUcbExpDecayFields {
     type Rule = LinUcbExpDecayRule;
+    const FIELDS: &'static [&'static str] = &["c", "seed"];
     const ASKS: bool = true;
     const USES_WORKLOAD_FORECAST: bool = false;
     const STOCHASTIC: bool = true;

@@ -25,6 +25,7 @@ pub struct LinUcbFields {}
 
 impl RuleConfig for LinUcbFields {
     type Rule = LinUcbParams;
+    const FIELDS: &'static [&'static str] = &[];
     const ASKS: bool = false;
     const USES_WORKLOAD_FORECAST: bool = false;
     const STOCHASTIC: bool = false;

@@ -28,6 +28,7 @@ pub struct LinUcbQgFields {
 
 impl RuleConfig for LinUcbQgFields {
     type Rule = LinUcbQgParams;
+    const FIELDS: &'static [&'static str] = &["w"];
     const ASKS: bool = true;
     const USES_WORKLOAD_FORECAST: bool = true;
     const STOCHASTIC: bool = false;

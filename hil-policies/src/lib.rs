@@ -1,9 +1,11 @@
 //! # hil-policies
 //!
 //! The paper's four policies on one shared linear-arm estimator:
-//! [`LinUcb`], [`AlwaysQuery`], [`LinUcbExpDecay`] and [`LinUcbQg`], all over
-//! [`LinearArms`] (per-arm ridge regression in kernel or packed-Cholesky
-//! form, chosen by cost, exact to rounding).
+//! [`LinUcb`], [`AlwaysQuery`], [`LinUcbExpDecay`] and [`LinUcbQg`]. Each is
+//! the one policy type [`LinearPolicy`] — a [`LinearArms`] estimator
+//! (per-arm ridge regression in kernel or packed-Cholesky form, chosen by
+//! cost, exact to rounding) scored with the LinUCB bonus — with its own
+//! [`QueryRule`] deciding whether to act or to ask.
 //!
 //! Build a policy from validated parameters and an estimator, which may be
 //! pretrained once and cloned for every run:
@@ -21,23 +23,34 @@
 //! ```
 //!
 //! Configs name them `linucb`, `always_query`, `linucb_exp_decay` and
-//! `linucb_qg`.
+//! `linucb_qg` ([`POLICY_TYPES`]); all share the keys of
+//! [`EstimatorConfig`] (and `query_kind`, for those that ask), see
+//! [`LinearPolicyConfig`]. A new policy over the estimator is a folder with
+//! its rule ([`QueryRule`]), parameters and config fields
+//! ([`RuleConfig`]), plus one `register!` line in `config.rs`.
 
 mod always_query;
 mod common;
+mod config;
 pub mod estimator;
 mod exp_decay;
 mod linucb;
 mod params;
+mod policy;
 mod qg;
 
-pub use always_query::{AlwaysQuery, AlwaysQueryConfig, AlwaysQueryParams};
+pub use always_query::{AlwaysQuery, AlwaysQueryConfig, AlwaysQueryFields, AlwaysQueryParams};
+pub use config::{EstimatorConfig, LinearPolicyConfig, POLICY_TYPES, RuleConfig};
 pub use estimator::{
     ArmEstimate, EstimatorOptions, LinearArms, Representation, RepresentationChoice,
 };
-pub use exp_decay::{LinUcbExpDecay, LinUcbExpDecayConfig, LinUcbExpDecayParams};
-pub use linucb::{LinUcb, LinUcbConfig, LinUcbParams};
-pub use qg::{LinUcbQg, LinUcbQgConfig, LinUcbQgParams, QueryGap, query_gap};
+pub use exp_decay::{
+    LinUcbExpDecay, LinUcbExpDecayConfig, LinUcbExpDecayFields, LinUcbExpDecayParams,
+    LinUcbExpDecayRule,
+};
+pub use linucb::{LinUcb, LinUcbConfig, LinUcbFields, LinUcbParams};
+pub use policy::{LinearPolicy, QueryRule};
+pub use qg::{LinUcbQg, LinUcbQgConfig, LinUcbQgFields, LinUcbQgParams, QueryGap, query_gap};
 
 /// Does nothing; calling it keeps this crate (and its typetag registrations)
 /// linked into a binary that names its components only in configs.

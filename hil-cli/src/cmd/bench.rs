@@ -3,18 +3,28 @@
 //! Contexts and rewards are synthetic (random unit-scale vectors, rewards
 //! drawn from a hidden linear model); the point is the cost of the
 //! estimator, which does not depend on what the numbers mean.
+//!
+//! The policy is built through its `PolicyConfig` (`--policy TYPE`,
+//! `--set key=value`, `--policy-config FILE`, `--plugin PATH`), so any
+//! built-in or plugin policy type can be timed; the synthetic pretraining
+//! data reaches it as the environment's pretraining data would. Memory
+//! traffic (bytes per step, the bandwidth floor) is known only for the
+//! built-in estimator and is reported as absent for other policies.
 
+mod spec;
+
+use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
 
 use hil_core::{
-    ArmId, Choice, Context, DecisionInput, Feedback, HilError, LabelledObservation, Policy,
-    QueryHistory, QueryKind, Result, Timestep, WorkloadForecast, WorkloadModel,
+    ActionSpace, ArmId, BuildContext, Choice, Context, DecisionInput, Feedback, HilError,
+    LabelledObservation, QueryHistory, Result, Timestep, WorkloadForecast, WorkloadModel,
 };
-use hil_policies::{
-    AlwaysQuery, AlwaysQueryParams, EstimatorOptions, LinUcb, LinUcbExpDecay, LinUcbExpDecayParams,
-    LinUcbParams, LinUcbQg, LinUcbQgParams, LinearArms, Representation, RepresentationChoice,
-};
+use hil_policies::{EstimatorConfig, LinearArms, Representation};
 use serde_json::json;
+
+use spec::PolicySpec;
 
 /// Arguments of `hil bench`.
 #[derive(Debug, clap::Args)]
@@ -29,14 +39,6 @@ enum BenchWhat {
     Policy(PolicyBench),
 }
 
-#[derive(Debug, Clone, Copy)]
-enum PolicyName {
-    Linucb,
-    AlwaysQuery,
-    LinucbExpDecay,
-    LinucbQg,
-}
-
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 enum ReprArg {
     Auto,
@@ -44,11 +46,39 @@ enum ReprArg {
     Dense,
 }
 
+impl ReprArg {
+    /// The config spelling (`estimator.representation`).
+    fn config_name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Kernel => "kernel",
+            Self::Dense => "dense",
+        }
+    }
+}
+
 #[derive(Debug, clap::Args)]
 struct PolicyBench {
-    /// Which policy.
-    #[arg(long, default_value = "linucb_qg", value_parser = parse_policy)]
-    policy: PolicyName,
+    /// Policy config type: a built-in (linucb, always_query,
+    /// linucb_exp_decay, linucb_qg) or one a --plugin registers.
+    /// Default: the --policy-config file's `type`, else linucb_qg.
+    #[arg(long)]
+    policy: Option<String>,
+    /// Policy parameter as KEY=VALUE (a TOML value; bare words are
+    /// strings; dotted keys reach into tables, e.g.
+    /// estimator.representation=dense). Repeatable. Built-in policies get
+    /// alpha = 0.5, w = 0.2 (linucb_qg), c = 0.1 (linucb_exp_decay) and
+    /// pretrain = true unless set.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    sets: Vec<String>,
+    /// A TOML file whose top-level keys are the policy's table (as under
+    /// `[policy]` in an experiment config); --policy and --set override it.
+    #[arg(long, value_name = "FILE")]
+    policy_config: Option<PathBuf>,
+    /// Plugin library to load first, so that its policy types can be named.
+    /// Repeatable.
+    #[arg(long = "plugin", value_name = "PATH")]
+    plugins: Vec<PathBuf>,
     /// Context dimension d.
     #[arg(long, default_value_t = 2048)]
     dim: usize,
@@ -61,10 +91,12 @@ struct PolicyBench {
     /// Timed steps (each one decide + observe).
     #[arg(long, default_value_t = 200)]
     steps: usize,
-    /// Estimator representation.
-    #[arg(long, value_enum, default_value = "auto")]
-    representation: ReprArg,
-    /// Crossover (fraction of d) for the automatic representation.
+    /// Estimator representation (built-in policies only; shorthand for
+    /// --set estimator.representation=...).
+    #[arg(long, value_enum)]
+    representation: Option<ReprArg>,
+    /// Crossover (fraction of d) for the automatic representation
+    /// (built-in policies only; shorthand for --set estimator.crossover=...).
     #[arg(long)]
     crossover: Option<f64>,
     /// Label every pretraining context for every arm (as a dataset that
@@ -72,36 +104,12 @@ struct PolicyBench {
     /// contexts per arm.
     #[arg(long)]
     shared_contexts: bool,
-    /// Confidence weight α.
-    #[arg(long, default_value_t = 0.5)]
-    alpha: f64,
-    /// Ridge strength λ.
-    #[arg(long, default_value_t = 1.0)]
-    lambda: f64,
-    /// Workload weight w (LinUCB-QG).
-    #[arg(long, default_value_t = 0.2)]
-    w: f64,
-    /// Decay rate c (LinUCB-ExpDecay).
-    #[arg(long, default_value_t = 0.1)]
-    c: f64,
-    /// Seed of the synthetic data.
+    /// Seed of the synthetic data, also the policy's seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
-}
-
-fn parse_policy(s: &str) -> std::result::Result<PolicyName, String> {
-    match s {
-        "linucb" => Ok(PolicyName::Linucb),
-        "always_query" | "always-query" => Ok(PolicyName::AlwaysQuery),
-        "linucb_exp_decay" | "linucb-exp-decay" => Ok(PolicyName::LinucbExpDecay),
-        "linucb_qg" | "linucb-qg" => Ok(PolicyName::LinucbQg),
-        _ => Err(format!(
-            "unknown policy `{s}` (expected linucb, always_query, linucb_exp_decay or linucb_qg)"
-        )),
-    }
 }
 
 /// Runs `hil bench`.
@@ -154,6 +162,19 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
             "--steps, --arms and --dim must be at least 1",
         ));
     }
+    for path in &a.plugins {
+        hil_core::plugin::load(path)?;
+    }
+    let spec = PolicySpec {
+        policy: a.policy.clone(),
+        file: a.policy_config.clone(),
+        sets: a.sets.clone(),
+        representation: a.representation.map(|r| r.config_name().to_string()),
+        crossover: a.crossover,
+    };
+    let table = spec.table()?;
+    // Before the data are drawn: a bad setting fails at once.
+    let config = spec::parse(&table)?;
     let mut rng = Mix(a.seed);
     // Hidden linear reward model, one weight vector per arm.
     let truth: Vec<Context> = (0..a.arms).map(|_| rng.context(a.dim)).collect();
@@ -178,62 +199,31 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
             });
         }
     }
-    let mut options = EstimatorOptions {
-        representation: match a.representation {
-            ReprArg::Auto => RepresentationChoice::Auto,
-            ReprArg::Kernel => RepresentationChoice::Kernel,
-            ReprArg::Dense => RepresentationChoice::Dense,
-        },
-        ..Default::default()
-    };
-    if let Some(c) = a.crossover {
-        options.crossover = c;
-    }
+    let mut ctx = BuildContext::new(".", a.seed);
+    ctx.action_space = Some(ActionSpace::new((0..a.arms).map(|i| format!("arm{i}")))?);
+    ctx.context_dim = Some(a.dim);
+    ctx.pretraining = Some(Arc::from(data));
+
     let t0 = Instant::now();
-    let mut arms = LinearArms::with_options(a.arms, a.dim, a.lambda, options)?;
-    arms.pretrain(&data)?;
+    let mut policy = config.build(&ctx)?;
     let pretrain_s = t0.elapsed().as_secs_f64();
-    drop(data);
-
-    let reprs: Vec<Representation> = (0..a.arms)
-        .map(|i| arms.representation(ArmId(i)))
-        .collect::<Result<_>>()?;
-    let representation = if reprs.iter().all(|r| *r == Representation::Kernel) {
-        "kernel"
-    } else if reprs.iter().all(|r| *r == Representation::Dense) {
-        "dense"
-    } else {
-        "mixed"
-    };
-    let bytes_per_score = arms.bytes_per_score();
-    let bytes_per_update = arms.bytes_per_update(ArmId(0))?;
-    // A dense update rewrites the factor it read; a kernel update appends O(n).
-    let bytes_written = match arms.representation(ArmId(0))? {
-        Representation::Dense => bytes_per_update,
-        Representation::Kernel => 0,
-    };
-
-    let kind = QueryKind::default();
-    let mut policy: Box<dyn Policy> = match a.policy {
-        PolicyName::Linucb => Box::new(LinUcb::new(LinUcbParams::new(a.alpha)?, arms)),
-        PolicyName::AlwaysQuery => Box::new(AlwaysQuery::new(
-            AlwaysQueryParams::new(a.alpha, kind)?,
-            arms,
-        )),
-        PolicyName::LinucbExpDecay => Box::new(LinUcbExpDecay::new(
-            LinUcbExpDecayParams::new(a.alpha, a.c, kind)?,
-            arms,
-        )),
-        PolicyName::LinucbQg => Box::new(LinUcbQg::new(
-            LinUcbQgParams::new(a.alpha, a.w, kind)?,
-            arms,
-        )),
-    };
     policy.seed(a.seed);
+    // The built-in policies' memory traffic, read off a twin of their
+    // estimator built from the same options and data.
+    let traffic = match EstimatorConfig::from_policy_table(&table)? {
+        Some(est) => Some(Traffic::of(&est.build_estimator(&ctx)?)?),
+        None => None,
+    };
+    drop(ctx);
 
     // Read bandwidth is sampled between steps, so that the floor sees the
-    // same machine load as the steps do (this machine is shared).
-    let bw_buf: Vec<f64> = (0..BW_LEN).map(|i| (i % 7) as f64).collect();
+    // same machine load as the steps do (this machine is shared). Without
+    // a traffic figure there is no floor to compare with, so no probe.
+    let bw_buf: Vec<f64> = if traffic.is_some() {
+        (0..BW_LEN).map(|i| (i % 7) as f64).collect()
+    } else {
+        Vec::new()
+    };
     let mut bw_samples = Vec::new();
     let model = PerQuery;
     let mut history = QueryHistory::new();
@@ -242,7 +232,7 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
     let mut decide_us = Vec::with_capacity(a.steps);
     let mut queries = 0usize;
     for s in 0..(a.steps + warmup) {
-        if s % 20 == 0 {
+        if s % 20 == 0 && !bw_buf.is_empty() {
             bw_samples.push(read_bandwidth(&bw_buf));
         }
         let x = rng.context(a.dim);
@@ -290,10 +280,10 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
     }
     let per_step_us = median(&mut step_us.clone());
     let decide_median = median(&mut decide_us);
-    let bytes_per_step = bytes_per_score + bytes_per_update;
-    bw_samples.push(read_bandwidth(&bw_buf));
-    let bw = median(&mut bw_samples);
-    let floor_us = bytes_per_step as f64 / bw * 1e6;
+    let bw = (!bw_buf.is_empty()).then(|| {
+        bw_samples.push(read_bandwidth(&bw_buf));
+        median(&mut bw_samples)
+    });
     let load = std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|s| s.split_whitespace().next().map(str::to_string))
@@ -301,6 +291,9 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
     let mut sorted = step_us.clone();
     sorted.sort_by(f64::total_cmp);
     let pct = |p: f64| sorted[((sorted.len() - 1) as f64 * p).round() as usize];
+    let floors = traffic
+        .zip(bw)
+        .map(|(tr, bw)| Floors::new(&tr, bw, per_step_us, pct(0.1)));
     let out = json!({
         "policy": policy.name(),
         "dim": a.dim,
@@ -308,7 +301,7 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         "pretrain_per_arm": a.pretrain,
         "shared_contexts": a.shared_contexts,
         "steps": a.steps,
-        "representation": representation,
+        "representation": traffic.map(|t| t.representation),
         "per_step_us": per_step_us,
         "p10_step_us": pct(0.1),
         "p90_step_us": pct(0.9),
@@ -316,42 +309,110 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         "observe_us": per_step_us - decide_median,
         "pretrain_s": pretrain_s,
         "queries": queries,
-        "bytes_per_step": bytes_per_step,
-        "read_bandwidth_gb_s": bw / 1e9,
-        "bandwidth_floor_us": floor_us,
-        "ratio_to_floor": per_step_us / floor_us,
-        "p10_ratio_to_floor": pct(0.1) / floor_us,
-        "bytes_written_per_step": bytes_written,
-        "floor_with_writes_us": (bytes_per_step + bytes_written) as f64 / bw * 1e6,
-        "ratio_to_floor_with_writes": per_step_us * bw / 1e6 / (bytes_per_step + bytes_written) as f64,
+        "bytes_per_step": traffic.map(|t| t.bytes_read),
+        "read_bandwidth_gb_s": bw.map(|bw| bw / 1e9),
+        "bandwidth_floor_us": floors.map(|f| f.floor_us),
+        "ratio_to_floor": floors.map(|f| f.ratio),
+        "p10_ratio_to_floor": floors.map(|f| f.p10_ratio),
+        "bytes_written_per_step": traffic.map(|t| t.bytes_written),
+        "floor_with_writes_us": floors.map(|f| f.floor_with_writes_us),
+        "ratio_to_floor_with_writes": floors.map(|f| f.ratio_with_writes),
         "bandwidth_samples": bw_samples.len(),
         "load_average_1m": load,
         "data": "synthetic",
     });
     if a.json {
         println!("{out}");
-    } else {
-        println!(
-            "{} d={} arms={} pretrain/arm={} ({}): median decide+observe {:.1} µs \
-             (p10 {:.1}, p90 {:.1}); {} bytes/step, read bandwidth {:.2} GB/s, \
-             floor {:.1} µs, ratio {:.2}; pretraining {:.2} s; load {}; synthetic data",
-            policy.name(),
-            a.dim,
-            a.arms,
-            a.pretrain,
-            representation,
-            per_step_us,
-            pct(0.1),
-            pct(0.9),
-            bytes_per_step,
-            bw / 1e9,
-            floor_us,
-            per_step_us / floor_us,
-            pretrain_s,
-            load
-        );
+        return Ok(());
     }
+    let memory = match (traffic, floors) {
+        (Some(t), Some(f)) => format!(
+            "{} bytes/step, read bandwidth {:.2} GB/s, floor {:.1} µs, ratio {:.2}",
+            t.bytes_read,
+            f.bandwidth / 1e9,
+            f.floor_us,
+            f.ratio
+        ),
+        _ => "memory traffic n/a (not the built-in estimator)".to_string(),
+    };
+    println!(
+        "{} d={} arms={} pretrain/arm={} ({}): median decide+observe {:.1} µs \
+         (p10 {:.1}, p90 {:.1}); {memory}; pretraining {:.2} s; load {}; synthetic data",
+        policy.name(),
+        a.dim,
+        a.arms,
+        a.pretrain,
+        traffic.map_or("representation n/a", |t| t.representation),
+        per_step_us,
+        pct(0.1),
+        pct(0.9),
+        pretrain_s,
+        load
+    );
     Ok(())
+}
+
+/// What one step of the built-in estimator reads and writes.
+#[derive(Clone, Copy, Debug)]
+struct Traffic {
+    /// `kernel`, `dense` or `mixed` (over the arms).
+    representation: &'static str,
+    /// Bytes read by one score of every arm plus one update.
+    bytes_read: usize,
+    /// Bytes one update writes.
+    bytes_written: usize,
+}
+
+impl Traffic {
+    fn of(arms: &LinearArms) -> Result<Self> {
+        let reprs: Vec<Representation> = (0..arms.n_arms())
+            .map(|i| arms.representation(ArmId(i)))
+            .collect::<Result<_>>()?;
+        let representation = if reprs.iter().all(|r| *r == Representation::Kernel) {
+            "kernel"
+        } else if reprs.iter().all(|r| *r == Representation::Dense) {
+            "dense"
+        } else {
+            "mixed"
+        };
+        let bytes_per_update = arms.bytes_per_update(ArmId(0))?;
+        // A dense update rewrites the factor it read; a kernel update appends O(n).
+        let bytes_written = match arms.representation(ArmId(0))? {
+            Representation::Dense => bytes_per_update,
+            Representation::Kernel => 0,
+        };
+        Ok(Self {
+            representation,
+            bytes_read: arms.bytes_per_score() + bytes_per_update,
+            bytes_written,
+        })
+    }
+}
+
+/// The bandwidth floors of a step and the measured times relative to them.
+#[derive(Clone, Copy, Debug)]
+struct Floors {
+    bandwidth: f64,
+    floor_us: f64,
+    ratio: f64,
+    p10_ratio: f64,
+    floor_with_writes_us: f64,
+    ratio_with_writes: f64,
+}
+
+impl Floors {
+    fn new(t: &Traffic, bandwidth: f64, median_us: f64, p10_us: f64) -> Self {
+        let floor_us = t.bytes_read as f64 / bandwidth * 1e6;
+        let floor_with_writes_us = (t.bytes_read + t.bytes_written) as f64 / bandwidth * 1e6;
+        Self {
+            bandwidth,
+            floor_us,
+            ratio: median_us / floor_us,
+            p10_ratio: p10_us / floor_us,
+            floor_with_writes_us,
+            ratio_with_writes: median_us / floor_with_writes_us,
+        }
+    }
 }
 
 fn median(v: &mut [f64]) -> f64 {

@@ -1,14 +1,12 @@
 //! `type = "always_query"` in experiment configs.
 
-use hil_core::config::PolicyConfig;
-use hil_core::{BuildContext, Policy, QueryKind, Result};
+use hil_core::{QueryKind, Result};
 use serde::{Deserialize, Serialize};
 
-use super::{AlwaysQuery, AlwaysQueryParams};
-use crate::common;
-use crate::estimator::EstimatorOptions;
+use super::AlwaysQueryParams;
+use crate::config::{LinearPolicyConfig, RuleConfig};
 
-/// Config for [`AlwaysQuery`].
+/// Config for [`crate::AlwaysQuery`]: only the shared fields.
 ///
 /// ```toml
 /// [policy]
@@ -17,30 +15,20 @@ use crate::estimator::EstimatorOptions;
 /// pretrain = true
 /// query_kind = { response = "mcq", difficulty = "easy", distraction = "none" }
 /// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AlwaysQueryConfig {
-    /// Weight α ≥ 0 of the confidence bonus in the fallback arm.
-    pub alpha: f64,
-    /// Ridge strength λ > 0.
-    #[serde(default = "common::default_lambda")]
-    pub lambda: f64,
-    /// Pretrain on the environment's offline data (an error if it has none).
-    #[serde(default)]
-    pub pretrain: bool,
-    /// What to ask (default: easy multiple choice, no distraction).
-    #[serde(default)]
-    pub query_kind: QueryKind,
-    /// Estimator representation options.
-    #[serde(default)]
-    pub estimator: EstimatorOptions,
-}
+pub type AlwaysQueryConfig = LinearPolicyConfig<AlwaysQueryFields>;
 
-#[typetag::serde(name = "always_query")]
-impl PolicyConfig for AlwaysQueryConfig {
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
-        let params = AlwaysQueryParams::new(self.alpha, self.query_kind)?;
-        let arms = common::build_estimator(ctx, self.lambda, self.pretrain, self.estimator)?;
-        Ok(Box::new(AlwaysQuery::new(params, arms)))
+/// AlwaysQuery's own config fields: none.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AlwaysQueryFields {}
+
+impl RuleConfig for AlwaysQueryFields {
+    type Rule = AlwaysQueryParams;
+    const FIELDS: &'static [&'static str] = &[];
+    const ASKS: bool = true;
+    const USES_WORKLOAD_FORECAST: bool = false;
+    const STOCHASTIC: bool = false;
+    fn params(&self, alpha: f64, query_kind: QueryKind) -> Result<AlwaysQueryParams> {
+        AlwaysQueryParams::new(alpha, query_kind)
     }
 }

@@ -3,16 +3,15 @@
 
 mod config;
 
-pub use config::AlwaysQueryConfig;
+pub use config::{AlwaysQueryConfig, AlwaysQueryFields};
 
-use hil_core::{Decision, DecisionInput, Feedback, Policy, QueryKind, Result};
+use hil_core::{ArmId, Decision, DecisionInput, Diagnostics, QueryKind, Result};
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 
-use crate::common;
-use crate::estimator::LinearArms;
+use crate::estimator::ArmEstimate;
+use crate::policy::{LinearPolicy, QueryRule};
 
-/// AlwaysQuery hyperparameters.
+/// AlwaysQuery hyperparameters; also its rule, which has no state.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AlwaysQueryParams {
@@ -48,53 +47,27 @@ impl AlwaysQueryParams {
 /// };
 /// assert!(matches!(p.decide(&input).unwrap().choice, Choice::Query { .. }));
 /// ```
-#[derive(Clone, Debug)]
-pub struct AlwaysQuery {
-    params: AlwaysQueryParams,
-    arms: LinearArms,
-}
+pub type AlwaysQuery = LinearPolicy<AlwaysQueryParams>;
 
-impl AlwaysQuery {
-    /// AlwaysQuery over `arms` (possibly pretrained).
-    pub fn new(params: AlwaysQueryParams, arms: LinearArms) -> Self {
-        Self { params, arms }
+impl QueryRule for AlwaysQueryParams {
+    const NAME: &'static str = "always_query";
+    type Params = Self;
+    fn from_params(params: Self) -> Self {
+        params
     }
-
-    /// The parameters.
-    pub fn params(&self) -> AlwaysQueryParams {
-        self.params
+    fn params(&self) -> Self {
+        *self
     }
-
-    /// The estimator.
-    pub fn estimator(&self) -> &LinearArms {
-        &self.arms
+    fn alpha(&self) -> f64 {
+        self.alpha
     }
-}
-
-impl Policy for AlwaysQuery {
-    fn name(&self) -> &str {
-        "always_query"
-    }
-    fn n_arms(&self) -> usize {
-        self.arms.n_arms()
-    }
-    fn dim(&self) -> usize {
-        self.arms.dim()
-    }
-    fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
-        let (s, diag) = common::score(&mut self.arms, input, self.params.alpha)?;
-        let fallback = common::ucb_arm(&s, self.params.alpha);
-        Ok(Decision::query(self.params.query_kind, fallback).with_diagnostics(diag))
-    }
-    fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()> {
-        common::learn(&mut self.arms, feedback)
-    }
-    fn save(&self) -> Result<Value> {
-        Ok(common::save(self.name(), &self.arms, Value::Null))
-    }
-    fn restore(&mut self, state: Value) -> Result<()> {
-        let (arms, _) = common::restore(self, state)?;
-        self.arms = arms;
-        Ok(())
+    fn decide(
+        &mut self,
+        _scores: &[ArmEstimate],
+        ucb_arm: ArmId,
+        _input: &DecisionInput<'_>,
+        _diag: &mut Diagnostics,
+    ) -> Result<Decision> {
+        Ok(Decision::query(self.query_kind, ucb_arm))
     }
 }

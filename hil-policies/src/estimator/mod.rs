@@ -4,7 +4,7 @@
 //! bonus b_a(x) = sqrt(xᵀA_a⁻¹x). Each arm is held in the cheaper of two
 //! exact representations ([`Representation`]): the kernel (Woodbury) form
 //! while it has few observations compared with d, a packed dense Cholesky
-//! factor beyond. Both agree with a direct inverse ([`reference`]) to
+//! factor beyond. Both agree with a direct inverse ([`reference`](mod@reference)) to
 //! rounding.
 
 mod checkpoint;

@@ -1,15 +1,13 @@
 //! `type = "linucb_exp_decay"` in experiment configs.
 
-use hil_core::config::PolicyConfig;
-use hil_core::{BuildContext, Policy, QueryKind, Result};
+use hil_core::{QueryKind, Result};
 use serde::{Deserialize, Serialize};
 
-use super::{LinUcbExpDecay, LinUcbExpDecayParams};
-use crate::common;
-use crate::estimator::EstimatorOptions;
+use super::{LinUcbExpDecayParams, LinUcbExpDecayRule};
+use crate::config::{LinearPolicyConfig, RuleConfig};
 
-/// Config for [`LinUcbExpDecay`]. The policy is seeded from the experiment
-/// seed unless `seed` is given.
+/// Config for [`crate::LinUcbExpDecay`]. The policy is seeded from the
+/// experiment seed unless `seed` is given.
 ///
 /// ```toml
 /// [policy]
@@ -18,37 +16,29 @@ use crate::estimator::EstimatorOptions;
 /// c = 0.3
 /// pretrain = true
 /// ```
+pub type LinUcbExpDecayConfig = LinearPolicyConfig<LinUcbExpDecayFields>;
+
+/// LinUCB-ExpDecay's own config fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct LinUcbExpDecayConfig {
-    /// Weight α ≥ 0 of the confidence bonus.
-    pub alpha: f64,
+pub struct LinUcbExpDecayFields {
     /// Decay rate c ≥ 0.
     pub c: f64,
-    /// Ridge strength λ > 0.
-    #[serde(default = "common::default_lambda")]
-    pub lambda: f64,
-    /// Pretrain on the environment's offline data (an error if it has none).
-    #[serde(default)]
-    pub pretrain: bool,
-    /// What to ask (default: easy multiple choice, no distraction).
-    #[serde(default)]
-    pub query_kind: QueryKind,
     /// Policy seed (default: the experiment seed).
     #[serde(default)]
     pub seed: Option<u64>,
-    /// Estimator representation options.
-    #[serde(default)]
-    pub estimator: EstimatorOptions,
 }
 
-#[typetag::serde(name = "linucb_exp_decay")]
-impl PolicyConfig for LinUcbExpDecayConfig {
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
-        let params = LinUcbExpDecayParams::new(self.alpha, self.c, self.query_kind)?;
-        let arms = common::build_estimator(ctx, self.lambda, self.pretrain, self.estimator)?;
-        let mut p = LinUcbExpDecay::new(params, arms);
-        p.seed(self.seed.unwrap_or(ctx.seed));
-        Ok(Box::new(p))
+impl RuleConfig for LinUcbExpDecayFields {
+    type Rule = LinUcbExpDecayRule;
+    const FIELDS: &'static [&'static str] = &["c", "seed"];
+    const ASKS: bool = true;
+    const USES_WORKLOAD_FORECAST: bool = false;
+    const STOCHASTIC: bool = true;
+    fn params(&self, alpha: f64, query_kind: QueryKind) -> Result<LinUcbExpDecayParams> {
+        LinUcbExpDecayParams::new(alpha, self.c, query_kind)
+    }
+    fn seed(&self) -> Option<u64> {
+        self.seed
     }
 }

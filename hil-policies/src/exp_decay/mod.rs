@@ -4,16 +4,16 @@
 mod config;
 mod rng_state;
 
-pub use config::LinUcbExpDecayConfig;
+pub use config::{LinUcbExpDecayConfig, LinUcbExpDecayFields};
 
-use hil_core::{Decision, DecisionInput, Feedback, Policy, QueryKind, Result};
+use hil_core::{ArmId, Decision, DecisionInput, Diagnostics, QueryKind, Result};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use crate::common;
-use crate::estimator::LinearArms;
+use crate::estimator::ArmEstimate;
+use crate::policy::{LinearPolicy, QueryRule};
 
 /// LinUCB-ExpDecay hyperparameters.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -46,7 +46,7 @@ impl LinUcbExpDecayParams {
 }
 
 /// A naive querying baseline with its own seeded randomness
-/// ([`Policy::seed`]; the RNG state is part of checkpoints).
+/// ([`hil_core::Policy::seed`]; the RNG state is part of checkpoints).
 ///
 /// ```
 /// use hil_core::{Choice, Context, DecisionInput, Policy, QueryHistory, QueryKind, WorkloadForecast};
@@ -66,81 +66,60 @@ impl LinUcbExpDecayParams {
 /// input.attempt = 1; // later attempts never query
 /// assert!(matches!(p.decide(&input).unwrap().choice, Choice::Act { .. }));
 /// ```
+pub type LinUcbExpDecay = LinearPolicy<LinUcbExpDecayRule>;
+
+/// The rule of [`LinUcbExpDecay`]: its parameters and its RNG, seeded
+/// with 0 until [`hil_core::Policy::seed`] is called.
 #[derive(Clone, Debug)]
-pub struct LinUcbExpDecay {
+pub struct LinUcbExpDecayRule {
     params: LinUcbExpDecayParams,
-    arms: LinearArms,
     rng: ChaCha8Rng,
 }
 
-impl LinUcbExpDecay {
-    /// LinUCB-ExpDecay over `arms` (possibly pretrained), seeded with 0
-    /// until [`Policy::seed`] is called.
-    pub fn new(params: LinUcbExpDecayParams, arms: LinearArms) -> Self {
+impl QueryRule for LinUcbExpDecayRule {
+    const NAME: &'static str = "linucb_exp_decay";
+    type Params = LinUcbExpDecayParams;
+    fn from_params(params: LinUcbExpDecayParams) -> Self {
         Self {
             params,
-            arms,
             rng: ChaCha8Rng::seed_from_u64(0),
         }
     }
-
-    /// The parameters.
-    pub fn params(&self) -> LinUcbExpDecayParams {
+    fn params(&self) -> LinUcbExpDecayParams {
         self.params
     }
-
-    /// The estimator.
-    pub fn estimator(&self) -> &LinearArms {
-        &self.arms
+    fn alpha(&self) -> f64 {
+        self.params.alpha
     }
-}
-
-impl Policy for LinUcbExpDecay {
-    fn name(&self) -> &str {
-        "linucb_exp_decay"
-    }
-    fn n_arms(&self) -> usize {
-        self.arms.n_arms()
-    }
-    fn dim(&self) -> usize {
-        self.arms.dim()
-    }
-    fn seed(&mut self, seed: u64) {
-        self.rng = ChaCha8Rng::seed_from_u64(seed);
-    }
-    fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
-        let (s, mut diag) = common::score(&mut self.arms, input, self.params.alpha)?;
-        let arm = common::ucb_arm(&s, self.params.alpha);
+    fn decide(
+        &mut self,
+        _scores: &[ArmEstimate],
+        ucb_arm: ArmId,
+        input: &DecisionInput<'_>,
+        diag: &mut Diagnostics,
+    ) -> Result<Decision> {
         if input.attempt != 0 {
-            return Ok(Decision::act(arm).with_diagnostics(diag));
+            return Ok(Decision::act(ucb_arm));
         }
         let p = self.params.query_probability(input.items_seen);
         diag.query_probability = Some(p);
         // One draw per item's first timestep, whatever p is, so the random
         // stream does not depend on the decay rate.
         let u: f64 = self.rng.random();
-        let d = if u < p {
-            Decision::query(self.params.query_kind, arm)
+        Ok(if u < p {
+            Decision::query(self.params.query_kind, ucb_arm)
         } else {
-            Decision::act(arm)
-        };
-        Ok(d.with_diagnostics(diag))
+            Decision::act(ucb_arm)
+        })
     }
-    fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()> {
-        common::learn(&mut self.arms, feedback)
+    fn seed(&mut self, seed: u64) {
+        self.rng = ChaCha8Rng::seed_from_u64(seed);
     }
-    fn save(&self) -> Result<Value> {
-        Ok(common::save(
-            self.name(),
-            &self.arms,
-            rng_state::save(&self.rng),
-        ))
+    fn save_state(&self) -> Value {
+        rng_state::save(&self.rng)
     }
-    fn restore(&mut self, state: Value) -> Result<()> {
-        let (arms, extra) = common::restore(self, state)?;
-        let rng = rng_state::restore(extra)?;
-        self.arms = arms;
-        self.rng = rng;
+    fn restore_state(&mut self, state: Value) -> Result<()> {
+        self.rng = rng_state::restore(state)?;
         Ok(())
     }
 }

@@ -1,14 +1,13 @@
 //! `type = "linucb"` in experiment configs.
 
-use hil_core::config::PolicyConfig;
-use hil_core::{BuildContext, Policy, Result};
+use hil_core::{QueryKind, Result};
 use serde::{Deserialize, Serialize};
 
-use super::{LinUcb, LinUcbParams};
-use crate::common;
-use crate::estimator::EstimatorOptions;
+use super::LinUcbParams;
+use crate::config::{LinearPolicyConfig, RuleConfig};
 
-/// Config for [`LinUcb`].
+/// Config for [`crate::LinUcb`]: only the shared fields (no `query_kind`,
+/// it never asks).
 ///
 /// ```toml
 /// [policy]
@@ -17,27 +16,20 @@ use crate::estimator::EstimatorOptions;
 /// lambda = 1.0        # default 1
 /// pretrain = true     # fit on the environment's pretraining data first
 /// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LinUcbConfig {
-    /// Weight α ≥ 0 of the confidence bonus.
-    pub alpha: f64,
-    /// Ridge strength λ > 0.
-    #[serde(default = "common::default_lambda")]
-    pub lambda: f64,
-    /// Pretrain on the environment's offline data (an error if it has none).
-    #[serde(default)]
-    pub pretrain: bool,
-    /// Estimator representation options.
-    #[serde(default)]
-    pub estimator: EstimatorOptions,
-}
+pub type LinUcbConfig = LinearPolicyConfig<LinUcbFields>;
 
-#[typetag::serde(name = "linucb")]
-impl PolicyConfig for LinUcbConfig {
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
-        let params = LinUcbParams::new(self.alpha)?;
-        let arms = common::build_estimator(ctx, self.lambda, self.pretrain, self.estimator)?;
-        Ok(Box::new(LinUcb::new(params, arms)))
+/// LinUCB's own config fields: none.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinUcbFields {}
+
+impl RuleConfig for LinUcbFields {
+    type Rule = LinUcbParams;
+    const FIELDS: &'static [&'static str] = &[];
+    const ASKS: bool = false;
+    const USES_WORKLOAD_FORECAST: bool = false;
+    const STOCHASTIC: bool = false;
+    fn params(&self, alpha: f64, _query_kind: QueryKind) -> Result<LinUcbParams> {
+        LinUcbParams::new(alpha)
     }
 }

@@ -2,16 +2,16 @@
 
 mod config;
 
-pub use config::LinUcbConfig;
+pub use config::{LinUcbConfig, LinUcbFields};
 
-use hil_core::{Decision, DecisionInput, Feedback, Policy, Result};
+use hil_core::{ArmId, Decision, DecisionInput, Diagnostics, Result};
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 
-use crate::common;
-use crate::estimator::LinearArms;
+use crate::estimator::ArmEstimate;
+use crate::policy::{LinearPolicy, QueryRule};
 
-/// LinUCB hyperparameters (λ lives in the estimator).
+/// LinUCB hyperparameters (λ lives in the estimator); also its rule, which
+/// has no state.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LinUcbParams {
@@ -44,52 +44,27 @@ impl LinUcbParams {
 /// assert!(matches!(d.choice, Choice::Act { .. }));
 /// assert_eq!(d.diagnostics.arms.len(), 3);
 /// ```
-#[derive(Clone, Debug)]
-pub struct LinUcb {
-    params: LinUcbParams,
-    arms: LinearArms,
-}
+pub type LinUcb = LinearPolicy<LinUcbParams>;
 
-impl LinUcb {
-    /// LinUCB over `arms` (possibly pretrained).
-    pub fn new(params: LinUcbParams, arms: LinearArms) -> Self {
-        Self { params, arms }
+impl QueryRule for LinUcbParams {
+    const NAME: &'static str = "linucb";
+    type Params = Self;
+    fn from_params(params: Self) -> Self {
+        params
     }
-
-    /// The parameters.
-    pub fn params(&self) -> LinUcbParams {
-        self.params
+    fn params(&self) -> Self {
+        *self
     }
-
-    /// The estimator.
-    pub fn estimator(&self) -> &LinearArms {
-        &self.arms
+    fn alpha(&self) -> f64 {
+        self.alpha
     }
-}
-
-impl Policy for LinUcb {
-    fn name(&self) -> &str {
-        "linucb"
-    }
-    fn n_arms(&self) -> usize {
-        self.arms.n_arms()
-    }
-    fn dim(&self) -> usize {
-        self.arms.dim()
-    }
-    fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
-        let (s, diag) = common::score(&mut self.arms, input, self.params.alpha)?;
-        Ok(Decision::act(common::ucb_arm(&s, self.params.alpha)).with_diagnostics(diag))
-    }
-    fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()> {
-        common::learn(&mut self.arms, feedback)
-    }
-    fn save(&self) -> Result<Value> {
-        Ok(common::save(self.name(), &self.arms, Value::Null))
-    }
-    fn restore(&mut self, state: Value) -> Result<()> {
-        let (arms, _) = common::restore(self, state)?;
-        self.arms = arms;
-        Ok(())
+    fn decide(
+        &mut self,
+        _scores: &[ArmEstimate],
+        ucb_arm: ArmId,
+        _input: &DecisionInput<'_>,
+        _diag: &mut Diagnostics,
+    ) -> Result<Decision> {
+        Ok(Decision::act(ucb_arm))
     }
 }

@@ -1,14 +1,12 @@
 //! `type = "linucb_qg"` in experiment configs.
 
-use hil_core::config::PolicyConfig;
-use hil_core::{BuildContext, Policy, QueryKind, Result};
+use hil_core::{QueryKind, Result};
 use serde::{Deserialize, Serialize};
 
-use super::{LinUcbQg, LinUcbQgParams};
-use crate::common;
-use crate::estimator::EstimatorOptions;
+use super::LinUcbQgParams;
+use crate::config::{LinearPolicyConfig, RuleConfig};
 
-/// Config for [`LinUcbQg`].
+/// Config for [`crate::LinUcbQg`].
 ///
 /// ```toml
 /// [policy]
@@ -18,32 +16,23 @@ use crate::estimator::EstimatorOptions;
 /// pretrain = true
 /// query_kind = { response = "mcq", difficulty = "easy", distraction = "none" }
 /// ```
+pub type LinUcbQgConfig = LinearPolicyConfig<LinUcbQgFields>;
+
+/// LinUCB-QG's own config fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct LinUcbQgConfig {
-    /// Weight α ≥ 0 of the confidence bonus.
-    pub alpha: f64,
+pub struct LinUcbQgFields {
     /// Workload weight w ≥ 0.
     pub w: f64,
-    /// Ridge strength λ > 0.
-    #[serde(default = "common::default_lambda")]
-    pub lambda: f64,
-    /// Pretrain on the environment's offline data (an error if it has none).
-    #[serde(default)]
-    pub pretrain: bool,
-    /// What to ask (default: easy multiple choice, no distraction).
-    #[serde(default)]
-    pub query_kind: QueryKind,
-    /// Estimator representation options.
-    #[serde(default)]
-    pub estimator: EstimatorOptions,
 }
 
-#[typetag::serde(name = "linucb_qg")]
-impl PolicyConfig for LinUcbQgConfig {
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
-        let params = LinUcbQgParams::new(self.alpha, self.w, self.query_kind)?;
-        let arms = common::build_estimator(ctx, self.lambda, self.pretrain, self.estimator)?;
-        Ok(Box::new(LinUcbQg::new(params, arms)))
+impl RuleConfig for LinUcbQgFields {
+    type Rule = LinUcbQgParams;
+    const FIELDS: &'static [&'static str] = &["w"];
+    const ASKS: bool = true;
+    const USES_WORKLOAD_FORECAST: bool = true;
+    const STOCHASTIC: bool = false;
+    fn params(&self, alpha: f64, query_kind: QueryKind) -> Result<LinUcbQgParams> {
+        LinUcbQgParams::new(alpha, self.w, query_kind)
     }
 }

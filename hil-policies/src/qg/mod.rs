@@ -4,17 +4,16 @@
 mod config;
 mod gap;
 
-pub use config::LinUcbQgConfig;
+pub use config::{LinUcbQgConfig, LinUcbQgFields};
 pub use gap::{QueryGap, query_gap};
 
-use hil_core::{Decision, DecisionInput, Feedback, Policy, QueryKind, Result};
+use hil_core::{ArmId, Decision, DecisionInput, Diagnostics, QueryKind, Result};
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 
-use crate::common;
-use crate::estimator::LinearArms;
+use crate::estimator::ArmEstimate;
+use crate::policy::{LinearPolicy, QueryRule};
 
-/// LinUCB-QG hyperparameters.
+/// LinUCB-QG hyperparameters; also its rule, which has no state.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LinUcbQgParams {
@@ -63,67 +62,39 @@ impl LinUcbQgParams {
 /// assert!(matches!(d.choice, Choice::Query { .. }));
 /// assert!((d.diagnostics.gap.unwrap() - 2.0).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug)]
-pub struct LinUcbQg {
-    params: LinUcbQgParams,
-    arms: LinearArms,
-}
+pub type LinUcbQg = LinearPolicy<LinUcbQgParams>;
 
-impl LinUcbQg {
-    /// LinUCB-QG over `arms` (possibly pretrained).
-    pub fn new(params: LinUcbQgParams, arms: LinearArms) -> Self {
-        Self { params, arms }
+impl QueryRule for LinUcbQgParams {
+    const NAME: &'static str = "linucb_qg";
+    type Params = Self;
+    fn from_params(params: Self) -> Self {
+        params
     }
-
-    /// The parameters.
-    pub fn params(&self) -> LinUcbQgParams {
-        self.params
+    fn params(&self) -> Self {
+        *self
     }
-
-    /// The estimator.
-    pub fn estimator(&self) -> &LinearArms {
-        &self.arms
+    fn alpha(&self) -> f64 {
+        self.alpha
     }
-}
-
-impl Policy for LinUcbQg {
-    fn name(&self) -> &str {
-        "linucb_qg"
-    }
-    fn n_arms(&self) -> usize {
-        self.arms.n_arms()
-    }
-    fn dim(&self) -> usize {
-        self.arms.dim()
-    }
-    fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
-        let p = self.params;
-        let (s, mut diag) = common::score(&mut self.arms, input, p.alpha)?;
-        let arm = common::ucb_arm(&s, p.alpha);
-        let Some(g) = query_gap(&s, p.alpha) else {
-            return Ok(Decision::act(arm).with_diagnostics(diag));
+    fn decide(
+        &mut self,
+        scores: &[ArmEstimate],
+        ucb_arm: ArmId,
+        input: &DecisionInput<'_>,
+        diag: &mut Diagnostics,
+    ) -> Result<Decision> {
+        let Some(g) = query_gap(scores, self.alpha) else {
+            return Ok(Decision::act(ucb_arm));
         };
-        let wl = input.workload.if_queried(p.query_kind)?;
-        let threshold = p.w * wl;
+        let wl = input.workload.if_queried(self.query_kind)?;
+        let threshold = self.w * wl;
         diag.gap = Some(g.gap);
         diag.threshold = Some(threshold);
         diag.workload_forecast = Some(wl);
-        let d = if g.gap > threshold {
-            Decision::query(p.query_kind, arm)
+        Ok(if g.gap > threshold {
+            Decision::query(self.query_kind, ucb_arm)
         } else {
-            Decision::act(arm)
-        };
-        Ok(d.with_diagnostics(diag))
-    }
-    fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()> {
-        common::learn(&mut self.arms, feedback)
-    }
-    fn save(&self) -> Result<Value> {
-        Ok(common::save(self.name(), &self.arms, Value::Null))
-    }
-    fn restore(&mut self, state: Value) -> Result<()> {
-        let (arms, _) = common::restore(self, state)?;
-        self.arms = arms;
-        Ok(())
+            Decision::act(ucb_arm)
+        })
     }
 }

@@ -637,6 +637,19 @@ impl Protocol {
         self.settings.validate(&self.dataset, &self.models)?;
         let jobs = self.jobs()?;
         let ctx = self.build_context()?;
+        // Build every grid point once before running anything, so a value
+        // the policy refuses (e.g. a negative w) fails at once, by name.
+        for m in &self.settings.methods {
+            for point in m.grid() {
+                m.config(&point)?.build(&ctx).map_err(|e| {
+                    HilError::invalid_parameter(
+                        format!("methods.{}", m.label),
+                        point.as_ref().map_or("the policy".into(), |(n, v)| format!("{n} = {v}")),
+                        e.to_string(),
+                    )
+                })?;
+            }
+        }
         let total = jobs.len();
         let done = AtomicUsize::new(0);
         jobs.par_iter()

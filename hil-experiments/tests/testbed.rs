@@ -174,8 +174,15 @@ fn bad_settings_are_errors_that_name_the_field() {
     let e = settings.validate(&ds, &models).unwrap_err();
     assert!(matches!(&e, HilError::InvalidParameter { name, .. } if name == "methods[1].label"));
     let (ds, mut settings, models) = setup();
-    settings.methods[3].tune.insert("w".into(), vec![-1.0]);
-    assert!(settings.validate(&ds, &models).is_err());
+    settings.methods[3].tune.insert("w".into(), vec![1.0, -1.0]);
+    let e = Protocol::new(settings, ds, models)
+        .run_all(&|_, _| {})
+        .unwrap_err();
+    assert!(
+        matches!(&e, HilError::InvalidParameter { name, value, .. }
+            if name == "methods.LinUCB-QG" && value == "w = -1"),
+        "{e:?}"
+    );
 }
 
 #[test]

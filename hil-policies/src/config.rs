@@ -93,18 +93,28 @@ impl EstimatorConfig {
                 "the context dimension is unknown (build the environment first)",
             )
         })?;
-        let mut arms = LinearArms::with_options(n_arms, dim, self.lambda, self.estimator)?;
-        if self.pretrain {
-            let data = ctx.pretraining.as_ref().ok_or_else(|| {
-                HilError::invalid_parameter(
-                    "pretrain",
-                    true,
-                    "pretraining was requested but the environment offers no pretraining data",
-                )
-            })?;
-            arms.pretrain(data)?;
+        if !self.pretrain {
+            return LinearArms::with_options(n_arms, dim, self.lambda, self.estimator);
         }
-        Ok(arms)
+        let data = ctx.pretraining.as_ref().ok_or_else(|| {
+            HilError::invalid_parameter(
+                "pretrain",
+                true,
+                "pretraining was requested but the environment offers no pretraining data",
+            )
+        })?;
+        // A protocol builds hundreds of policies from one context: pretrain
+        // each distinct estimator once and clone it (the clone is exact).
+        let key = format!(
+            "hil_policies::LinearArms/{n_arms}/{dim}/{:?}/{:?}",
+            self.lambda.to_bits(),
+            self.estimator
+        );
+        ctx.memo.get_or_try_insert(&key, || {
+            let mut arms = LinearArms::with_options(n_arms, dim, self.lambda, self.estimator)?;
+            arms.pretrain(data)?;
+            Ok(arms)
+        })
     }
 }
 

@@ -4,10 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use hil_core::{
-    Difficulty, Distraction, HilError, QueryHistory, QueryKind, ResponseType, Result, Timestep,
-    WorkloadModel,
-};
+use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadModel};
 use hil_workload::bundle::{StudySummary, build_bundle, bundled_study};
 use hil_workload::datasets::{Dataset, DatasetId};
 use hil_workload::models::{FittedModel, Provenance};
@@ -292,7 +289,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 let mut asked = Vec::new();
                 while qi < queries.len() && queries[qi].0 == t {
                     history.push(t, queries[qi].1)?;
-                    asked.push(format_kind(&queries[qi].1));
+                    asked.push(queries[qi].1.to_string());
                     qi += 1;
                 }
                 let wl = m.predict(wl0, &history, t)?;
@@ -340,15 +337,6 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
     }
 }
 
-fn format_kind(k: &QueryKind) -> String {
-    format!(
-        "{}/{}/{}",
-        ["mcq", "bounding_box", "open_ended"][k.response as usize],
-        ["easy", "hard"][k.difficulty as usize],
-        ["none", "easy", "hard"][k.distraction as usize]
-    )
-}
-
 /// Parses `t:response/difficulty/distraction,...`.
 fn parse_schedule(s: &str) -> Result<Vec<(Timestep, QueryKind)>> {
     let mut out: Vec<(Timestep, QueryKind)> = Vec::new();
@@ -364,52 +352,11 @@ fn parse_schedule(s: &str) -> Result<Vec<(Timestep, QueryKind)>> {
             .trim()
             .parse()
             .map_err(|_| bad(format!("`{t}` is not a timestep (non-negative integer)")))?;
-        let mut k = QueryKind::default();
-        for (j, part) in kind
-            .split('/')
-            .map(str::trim)
-            .enumerate()
-            .filter(|(_, p)| !p.is_empty())
-        {
-            match j {
-                0 => {
-                    k.response = match part {
-                        "mcq" => ResponseType::Mcq,
-                        "bounding_box" | "bb" => ResponseType::BoundingBox,
-                        "open_ended" | "oe" => ResponseType::OpenEnded,
-                        _ => {
-                            return Err(bad(format!(
-                                "unknown response type `{part}` (mcq, bounding_box, open_ended)"
-                            )));
-                        }
-                    }
-                }
-                1 => {
-                    k.difficulty = match part {
-                        "easy" => Difficulty::Easy,
-                        "hard" => Difficulty::Hard,
-                        _ => return Err(bad(format!("unknown difficulty `{part}` (easy, hard)"))),
-                    }
-                }
-                2 => {
-                    k.distraction = match part {
-                        "none" => Distraction::None,
-                        "easy" => Distraction::Easy,
-                        "hard" => Distraction::Hard,
-                        _ => {
-                            return Err(bad(format!(
-                                "unknown distraction `{part}` (none, easy, hard)"
-                            )));
-                        }
-                    }
-                }
-                _ => {
-                    return Err(bad(
-                        "expected at most response/difficulty/distraction".into()
-                    ));
-                }
-            }
-        }
+        let k: QueryKind = if kind.trim().is_empty() {
+            QueryKind::default()
+        } else {
+            kind.parse().map_err(|e: HilError| bad(e.to_string()))?
+        };
         if let Some(prev) = out.last()
             && t < prev.0
         {
@@ -464,10 +411,11 @@ fn svg_plot(name: &str, wl0: f64, points: &[(Timestep, f64, bool)]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hil_core::ResponseType;
 
     #[test]
     fn schedule_parsing() {
-        let q = parse_schedule("3:mcq/easy/none, 9:oe/hard/easy,9").unwrap();
+        let q = parse_schedule("3:mcq/easy/none, 9:open_ended/hard/easy,9").unwrap();
         assert_eq!(q.len(), 3);
         assert_eq!(q[1].1.response, ResponseType::OpenEnded);
         assert_eq!(q[2].1, QueryKind::default());

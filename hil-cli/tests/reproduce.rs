@@ -6,6 +6,7 @@ mod common;
 use std::path::Path;
 
 use common::hil;
+use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
 
 fn text(o: &std::process::Output) -> String {
     format!(
@@ -59,7 +60,7 @@ fn data_generate_check_then_reproduce_quick() {
     assert!(json["provenance"].as_str().unwrap().contains("synthetic"));
     let tables = std::fs::read_to_string(res.join("tables.md")).unwrap();
     assert!(tables.contains("Table I") && tables.contains("0.292 ± 0.113"));
-    for f in ["qg_rollout.svg", "workload_5_items.svg"] {
+    for f in ["rollout.svg", "workload.svg"] {
         assert!(Path::new(&res.join(f)).exists(), "{f}");
     }
     std::fs::remove_dir_all(&root).unwrap();
@@ -83,5 +84,195 @@ fn reproduce_rejects_a_bad_split() {
     assert!(!out.status.success());
     let t = text(&out);
     assert!(t.contains("grape") && t.contains("split.test"), "{t}");
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// A small generated dataset (d = 224) in `root/ds`.
+fn small_dataset(root: &Path) -> String {
+    let ds = root.join("ds");
+    let ds_s = ds.to_str().unwrap().to_string();
+    let out = hil(&[
+        "data",
+        "generate",
+        "--out",
+        &ds_s,
+        "--dim",
+        "224",
+        "--images-per-setting",
+        "2",
+        "--force",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    ds_s
+}
+
+/// Protocol settings with one seed, one w_task and the given methods.
+fn small_settings(methods: &str, figures: &str) -> String {
+    format!(
+        r#"
+seed = 0
+n_seeds = 1
+n_policy_seeds = 1
+items_per_episode = 5
+w_tasks = [0.7]
+cross_w_task = 0.4
+
+[session]
+n_att = 10
+wl0 = 0.5
+
+[split]
+pretrain = ["apple", "bell_pepper", "broccoli", "cauliflower", "celery", "cherry_tomato",
+            "honeydew", "kiwi", "strawberry", "lettuce", "spinach", "kale"]
+validation = ["cantaloupe", "grape"]
+test = ["banana", "carrot"]
+
+{methods}
+
+[figures]
+model = "f2_sim"
+w_task = 0.7
+{figures}
+"#
+    )
+}
+
+#[test]
+fn hil_run_and_hil_reproduce_score_an_episode_alike() {
+    // One definition of ΔWL and M_wt: LinUCB never asks, so both commands
+    // score f2_sim's f(WL_0, ∅) − WL_0 at the episode's last step (before
+    // the change, `hil run` said 0 here and `hil reproduce` did not).
+    let root = std::env::temp_dir().join(format!("hil-cli-alike-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let ds = small_dataset(&root);
+    let settings = root.join("s.toml");
+    std::fs::write(
+        &settings,
+        small_settings(
+            "[[methods]]\nlabel = \"LinUCB\"\npolicy = { type = \"linucb\", alpha = 0.5, pretrain = true }",
+            "rollout = \"LinUCB\"\nworkload = [\"LinUCB\"]",
+        ),
+    )
+    .unwrap();
+    let out_dir = root.join("out");
+    let out = hil(&[
+        "reproduce",
+        "--quiet",
+        "--dataset",
+        &ds,
+        "--settings",
+        settings.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let res: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap())
+            .unwrap();
+    let row = res["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["model"] == "f2_sim" && r["method"] == "LinUCB")
+        .unwrap();
+    let reproduce_dwl = row["test"]["delta_wl"]["mean"].as_f64().unwrap();
+
+    let config = root.join("run.toml");
+    std::fs::write(
+        &config,
+        format!(
+            r#"
+seed = 3
+[environment]
+type = "food_replay"
+dataset = "{ds}"
+foods = ["banana", "carrot"]
+pretrain_foods = ["apple", "bell_pepper", "broccoli"]
+items_per_episode = 5
+[policy]
+type = "linucb"
+alpha = 0.5
+pretrain = true
+[workload]
+type = "bundled"
+name = "f2_sim"
+[channel]
+type = "simulated_expert"
+"#
+        ),
+    )
+    .unwrap();
+    let out = hil(&["run", "--config", config.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let run: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let m = &run["episodes"][0];
+    let run_dwl = m["delta_wl"].as_f64().unwrap();
+    assert!(run_dwl < -0.4, "f2_sim without queries is far below WL_0: {m}");
+    assert!((run_dwl - reproduce_dwl).abs() < 1e-12, "{run_dwl} vs {reproduce_dwl}");
+    // M_wt from the same definition: w·r − (1 − w)·ΔWL.
+    let r = row["test"]["r_task_avg"]["mean"].as_f64().unwrap();
+    let mwt = row["test"]["m_wt"]["mean"].as_f64().unwrap();
+    assert!((mwt - (0.7 * r - 0.3 * reproduce_dwl)).abs() < 1e-12);
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn a_plugin_policy_runs_in_reproduce_settings() {
+    let krate = "hil-example-policy-thompson";
+    let ws = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+    let lib_dir = build_cdylibs(ws, &[krate]).expect("the plugin builds");
+    let lib = cdylib_path(&lib_dir, krate);
+    let root = std::env::temp_dir().join(format!("hil-cli-plugin-repro-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let ds = small_dataset(&root);
+    let methods = format!(
+        r#"plugins = ["{}"]
+
+[[methods]]
+label = "LinUCB"
+policy = {{ type = "linucb", alpha = 0.5, pretrain = true }}
+
+[[methods]]
+label = "Thompson"
+policy = {{ type = "linear_thompson", v = 0.5 }}
+tune = {{ v = [0.1, 1.0] }}"#,
+        lib.display()
+    );
+    // `plugins` must come before any table: put it first.
+    let (plugins, methods) = methods.split_once("\n\n").unwrap();
+    let text_settings = format!(
+        "{plugins}\n{}",
+        small_settings(methods, "rollout = \"Thompson\"\nworkload = [\"Thompson\"]")
+    );
+    let settings = root.join("s.toml");
+    std::fs::write(&settings, text_settings).unwrap();
+    let out_dir = root.join("out");
+    let out = hil(&[
+        "reproduce",
+        "--dataset",
+        &ds,
+        "--settings",
+        settings.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let res: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap())
+            .unwrap();
+    let rows: Vec<&serde_json::Value> = res["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["method"] == "Thompson")
+        .collect();
+    assert_eq!(rows.len(), 3, "one row per workload model");
+    for r in rows {
+        assert_eq!(r["selected"]["name"], "v", "{r}");
+        assert!(r["test"]["n_runs"].as_u64().unwrap() >= 1);
+    }
+    assert!(text(&out).contains("Thompson"));
     std::fs::remove_dir_all(&root).unwrap();
 }

@@ -42,12 +42,12 @@ pub mod workload;
 #[cfg(feature = "testing")]
 pub mod testing;
 
-pub use action::{ActionSpace, ArmId, FEEDING_ACTIONS};
-pub use channel::QueryChannel;
+pub use action::{ActionSpace, ArmId};
+pub use channel::{PerfectExpert, QueryChannel};
 pub use config::{BuildContext, ConfigError, ExperimentConfig};
 pub use context::Context;
 pub use decision::{ArmDiagnostics, Choice, Decision, Diagnostics, LabelledObservation, Outcome};
-pub use environment::{Environment, Item};
+pub use environment::{CallOrder, Environment, Item};
 pub use error::{HilError, Result};
 pub use experiment::{Experiment, ExperimentSummary};
 pub use metrics::EpisodeMetrics;

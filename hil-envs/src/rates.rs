@@ -178,7 +178,7 @@ mod tests {
     #[test]
     fn bundled_table_is_complete_and_pooled_rows_are_setting_means() {
         let r = PublishedRates::bundled().unwrap();
-        assert_eq!(r.actions, hil_core::FEEDING_ACTIONS);
+        assert_eq!(r.actions, crate::feeding::action_space().names());
         assert_eq!(r.foods.len(), 16);
         for f in &r.foods {
             for a in 0..6 {

@@ -30,7 +30,7 @@ use crate::feeding::{ALL_SETTINGS, FeedingTask, FoodFacts};
 /// ```
 /// use hil_core::config::EnvironmentConfig;
 /// let cfg = hil_envs::demo_plate::DemoPlateConfig { foods: vec!["grape".into()], repeat: 2 };
-/// let env = cfg.build(&hil_core::BuildContext::default())?;
+/// let env = cfg.build(&hil_core::BuildContext::new(".", 0))?;
 /// assert_eq!(env.name(), "demo_plate");
 /// # Ok::<(), hil_core::HilError>(())
 /// ```

@@ -25,6 +25,7 @@
 
 mod always_query;
 mod common;
+pub mod demo_learner;
 pub mod estimator;
 mod exp_decay;
 mod linucb;

@@ -88,3 +88,48 @@ impl QueryChannel for PerfectExpert {
         Ok(Response::action(arm))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ActionSpace, ArmId, Context, Item};
+
+    fn query(best: Option<usize>) -> Query {
+        Query {
+            t: 3,
+            item: Item {
+                index: 0,
+                label: "x".into(),
+                description: None,
+            },
+            kind: Default::default(),
+            actions: ActionSpace::new(["a", "b", "c"]).unwrap(),
+            context: Context::new(vec![0.5]).unwrap(),
+            oracle_best: best.map(ArmId),
+        }
+    }
+
+    #[test]
+    fn the_perfect_expert_answers_the_oracle_and_counts() {
+        let mut e = PerfectExpert::default();
+        for best in 0..3 {
+            assert_eq!(
+                e.ask(&query(Some(best))).unwrap(),
+                Response::action(ArmId(best))
+            );
+        }
+        assert_eq!(e.asked, 3);
+        assert_eq!(e.name(), "perfect_expert");
+    }
+
+    #[test]
+    fn an_unknown_or_impossible_best_action_is_an_error() {
+        let mut e = PerfectExpert::default();
+        assert!(matches!(e.ask(&query(None)), Err(HilError::Channel { .. })));
+        assert!(matches!(
+            e.ask(&query(Some(3))),
+            Err(HilError::ArmOutOfRange { arm: 3, n_arms: 3 })
+        ));
+        assert_eq!(e.asked, 0);
+    }
+}

@@ -10,7 +10,8 @@
 //!   [`Timestep`]/[`TimeGrid`].
 //! - The four traits: [`Policy`], [`WorkloadModel`], [`QueryChannel`],
 //!   [`Environment`]; object-safe, so they can be named in configs and
-//!   cross plugin boundaries.
+//!   cross plugin boundaries. [`CallOrder`] is the environments' shared
+//!   call-order check; [`PerfectExpert`] is the paper's perfect expert.
 //! - The loop: [`Session`] runs episodes with the paper's semantics and
 //!   emits one [`StepEvent`] per step; [`EpisodeMetrics`] computes the
 //!   paper's metrics from those events.

@@ -19,6 +19,17 @@ use hil_core::{BuildContext, HilError, QueryHistory, Result, Timestep, WorkloadM
 /// increment = 0.05   # each query in the window adds this
 /// window = 10        # timesteps a query keeps counting (H)
 /// ```
+///
+/// ```
+/// use hil_core::{QueryHistory, QueryKind, WorkloadModel};
+/// use hil_workload::demo_counting::DemoCounting;
+///
+/// let model = DemoCounting { increment: 0.1, window: 10 };
+/// let mut history = QueryHistory::new();
+/// history.push(4, QueryKind::default())?;
+/// assert!((model.predict(0.5, &history, 5)? - 0.6).abs() < 1e-12);
+/// # Ok::<(), hil_core::HilError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DemoCounting {

@@ -67,6 +67,27 @@ impl PolicyConfig for DemoLearnerConfig {
 /// A small seeded learner: per context feature and arm it keeps a weighted
 /// success count, acts greedily on it (with ε-exploration), and asks with a
 /// fixed probability at an item's first attempt.
+///
+/// ```
+/// use hil_core::{Choice, Context, DecisionInput, Policy, QueryHistory, WorkloadForecast};
+/// use hil_policies::demo_learner::{DemoLearner, DemoLearnerConfig};
+///
+/// let params = DemoLearnerConfig { query_probability: 1.0, epsilon: 0.0, kinds: vec![] };
+/// let mut learner = DemoLearner::new(3, 2, params);
+/// let context = Context::new(vec![1.0, 0.0])?;
+/// let history = QueryHistory::new();
+/// let input = DecisionInput {
+///     context: &context,
+///     t: 1,
+///     item_index: 0,
+///     items_seen: 0,
+///     attempt: 0,
+///     workload: WorkloadForecast::none(&history),
+/// };
+/// // With query_probability = 1 it asks at every first attempt.
+/// assert!(matches!(learner.decide(&input)?.choice, Choice::Query { .. }));
+/// # Ok::<(), hil_core::HilError>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct DemoLearner {
     n_arms: usize,

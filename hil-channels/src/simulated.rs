@@ -1,11 +1,13 @@
-//! Simulated experts: the paper's perfect expert and imperfect ones that
-//! err, decline and take time to answer.
+//! Simulated experts: people who know the best action (the paper's perfect
+//! expert, [`hil_core::channel::PerfectExpert`]) but may err, decline and
+//! take time to answer.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, LogNormal};
 use serde::{Deserialize, Serialize};
 
+use hil_core::channel::PerfectExpert;
 use hil_core::config::QueryChannelConfig;
 use hil_core::session::splitmix;
 use hil_core::{
@@ -110,9 +112,16 @@ impl QueryChannelConfig for SimulatedExpertConfig {
     }
 }
 
-/// A simulated person who knows the best action (from the environment's
-/// oracle) and answers every query, as in the paper's simulations, possibly
-/// with errors, declines and response times.
+/// A simulated person who knows the best action and answers every query,
+/// as in the paper's simulations, possibly with errors, declines and
+/// response times.
+///
+/// The truth comes from the one perfect expert,
+/// [`hil_core::channel::PerfectExpert`] (the environment's known best
+/// action): with default parameters (the `simulated_expert` config with no
+/// fields) a simulated expert always names that action, and so is the
+/// paper's perfect expert. Use `PerfectExpert` itself where the answer's
+/// shape and timing do not matter.
 ///
 /// As in the paper, the response type only changes how much workload a
 /// query costs: whatever the type, the simulated answer determines the
@@ -125,8 +134,8 @@ impl QueryChannelConfig for SimulatedExpertConfig {
 ///
 /// ```
 /// use hil_channels::{SimulatedExpert, SimulatedExpertConfig};
-/// let mut expert = SimulatedExpert::perfect();
-/// hil_core::testing::check_query_channel(&mut expert, 18).unwrap();
+/// let mut perfect = SimulatedExpert::new(SimulatedExpertConfig::default()).unwrap();
+/// hil_core::testing::check_query_channel(&mut perfect, 18).unwrap();
 /// let noisy = SimulatedExpert::new(SimulatedExpertConfig { error_rate: 0.2, ..Default::default() });
 /// assert!(noisy.is_ok());
 /// ```
@@ -134,21 +143,18 @@ impl QueryChannelConfig for SimulatedExpertConfig {
 pub struct SimulatedExpert {
     params: SimulatedExpertConfig,
     seed: u64,
+    truth: PerfectExpert,
 }
 
 impl SimulatedExpert {
     /// An expert with validated parameters.
     pub fn new(params: SimulatedExpertConfig) -> Result<Self> {
         params.validate()?;
-        Ok(Self { params, seed: 0 })
-    }
-
-    /// The paper's perfect expert: always answers the best action, instantly.
-    pub fn perfect() -> Self {
-        Self {
-            params: SimulatedExpertConfig::default(),
+        Ok(Self {
+            params,
             seed: 0,
-        }
+            truth: PerfectExpert::default(),
+        })
     }
 
     /// The parameters.
@@ -167,13 +173,18 @@ impl QueryChannel for SimulatedExpert {
     }
 
     fn ask(&mut self, query: &Query) -> Result<Response> {
-        let best = query.oracle_best.ok_or_else(|| HilError::Channel {
-            channel: self.name().into(),
-            why:
-                "the environment does not know its best action, so a simulated expert cannot answer"
-                    .into(),
-        })?;
-        query.actions.check(best)?;
+        // The perfect expert checks that the environment knows its best
+        // action and that it indexes the action space.
+        let Response {
+            expert_arm: Some(best),
+            ..
+        } = self.truth.ask(query)?
+        else {
+            return Err(HilError::Channel {
+                channel: self.name().into(),
+                why: "the perfect expert named no action".into(),
+            });
+        };
         let mut rng = ChaCha8Rng::seed_from_u64(splitmix(self.seed, query.t));
         // Draw every random quantity unconditionally, in a fixed order, so
         // that changing one rate does not reshuffle the others.

@@ -52,7 +52,7 @@ impl QueryChannelConfig for TerminalChannelConfig {
 ///
 /// ```
 /// use hil_channels::TerminalChannel;
-/// use hil_core::{ActionSpace, ArmId, Context, Item, Query, QueryChannel, QueryKind};
+/// use hil_core::{ArmId, Context, Item, Query, QueryChannel, QueryKind};
 /// let input: &[u8] = b"7\n2\n";  // 7 is out of range: asked again
 /// let mut out = Vec::new();
 /// let mut ch = TerminalChannel::new(input, &mut out);
@@ -60,7 +60,7 @@ impl QueryChannelConfig for TerminalChannelConfig {
 ///     t: 1,
 ///     item: Item { index: 0, label: "banana".into(), description: None },
 ///     kind: QueryKind::default(),
-///     actions: ActionSpace::feeding(),
+///     actions: hil_envs::feeding::action_space(),
 ///     context: Context::new(vec![0.0]).unwrap(),
 ///     oracle_best: None,
 /// };

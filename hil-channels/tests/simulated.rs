@@ -1,12 +1,11 @@
-//! Simulated experts and the demo components: conformance, rates, seeding
-//! and configs.
+//! Simulated experts: conformance, rates, seeding and configs.
 
-use hil_channels::demo::{DemoLearner, DemoLearnerConfig, DemoPlate};
 use hil_channels::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
+use hil_core::channel::PerfectExpert;
 use hil_core::config::QueryChannelConfig;
-use hil_core::testing::{check_environment, check_policy, check_query_channel};
+use hil_core::testing::check_query_channel;
 use hil_core::{
-    ActionSpace, Answer, ArmId, BuildContext, Context, Item, Query, QueryChannel, QueryKind,
+    Answer, ArmId, BuildContext, Context, HilError, Item, Query, QueryChannel, QueryKind,
     ResponseType,
 };
 
@@ -22,10 +21,15 @@ fn query(t: u64, best: usize, response: ResponseType) -> Query {
             response,
             ..Default::default()
         },
-        actions: ActionSpace::feeding(),
+        actions: hil_envs::feeding::action_space(),
         context: Context::new(vec![1.0, 0.0]).unwrap(),
         oracle_best: Some(ArmId(best)),
     }
+}
+
+/// The simulated expert with default parameters: the paper's perfect expert.
+fn perfect() -> SimulatedExpert {
+    SimulatedExpert::new(SimulatedExpertConfig::default()).unwrap()
 }
 
 fn expert(error_rate: f64, decline_rate: f64) -> SimulatedExpert {
@@ -42,14 +46,15 @@ fn expert(error_rate: f64, decline_rate: f64) -> SimulatedExpert {
 
 #[test]
 fn perfect_and_imperfect_experts_conform() {
-    check_query_channel(&mut SimulatedExpert::perfect(), 36).unwrap();
+    check_query_channel(&mut PerfectExpert::default(), 36).unwrap();
+    check_query_channel(&mut perfect(), 36).unwrap();
     check_query_channel(&mut expert(0.3, 0.2), 36).unwrap();
     check_query_channel(&mut expert(1.0, 0.0), 36).unwrap();
 }
 
 #[test]
 fn perfect_expert_always_answers_the_best_action() {
-    let mut e = SimulatedExpert::perfect();
+    let mut e = perfect();
     for t in 1..50 {
         let best = (t as usize * 7) % 6;
         for rt in ResponseType::ALL {
@@ -62,7 +67,7 @@ fn perfect_expert_always_answers_the_best_action() {
                     assert!(0.0 <= bbox.x0 && bbox.x0 < bbox.x1 && bbox.x1 <= 1.0)
                 }
                 (ResponseType::OpenEnded, Answer::Text { text }) => {
-                    assert!(text.contains(hil_core::FEEDING_ACTIONS[best]))
+                    assert!(text.contains(hil_envs::feeding::action_space().names()[best].as_str()))
                 }
                 other => panic!("unexpected answer {other:?}"),
             }
@@ -148,8 +153,11 @@ fn seeded_answers_are_reproducible_and_independent_of_skipped_queries() {
 fn missing_oracle_is_a_clear_error() {
     let mut q = query(1, 0, ResponseType::Mcq);
     q.oracle_best = None;
-    let err = SimulatedExpert::perfect().ask(&q).unwrap_err().to_string();
-    assert!(err.contains("best action"), "{err}");
+    assert!(matches!(perfect().ask(&q), Err(HilError::Channel { .. })));
+    assert!(matches!(
+        PerfectExpert::default().ask(&q),
+        Err(HilError::Channel { .. })
+    ));
 }
 
 #[derive(serde::Deserialize)]
@@ -182,36 +190,4 @@ fn config_parses_validates_and_rejects_unknown_fields() {
         toml::from_str::<Doc>("[channel]\ntype = \"simulated_expert\"\neror_rate = 0.1\n");
     let err = unknown.err().unwrap().to_string();
     assert!(err.contains("eror_rate"), "{err}");
-}
-
-#[test]
-fn demo_components_conform() {
-    check_environment(
-        &|| {
-            Ok(Box::new(DemoPlate::new(
-                &["banana".into(), "carrot".into(), "grape".into()],
-                2,
-            )?))
-        },
-        4,
-    )
-    .unwrap();
-    check_policy(&|| {
-        Ok(Box::new(DemoLearner::new(
-            6,
-            5,
-            DemoLearnerConfig {
-                query_probability: 0.4,
-                epsilon: 0.2,
-                kinds: vec![],
-            },
-        )))
-    })
-    .unwrap();
-    assert!(DemoPlate::new(&["pizza".into()], 1).is_err());
-    hil_core::testing::check_workload_model(&hil_channels::demo::DemoCounting {
-        increment: 0.05,
-        window: 10,
-    })
-    .unwrap();
 }

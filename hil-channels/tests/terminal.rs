@@ -4,8 +4,8 @@
 use hil_channels::TerminalChannel;
 use hil_core::testing::check_query_channel;
 use hil_core::{
-    ActionSpace, Answer, ArmId, BoundingBox, Context, Difficulty, Distraction, Item, Query,
-    QueryChannel, QueryKind, ResponseType,
+    Answer, ArmId, BoundingBox, Context, Difficulty, Distraction, Item, Query, QueryChannel,
+    QueryKind, ResponseType,
 };
 
 fn query(response: ResponseType) -> Query {
@@ -21,7 +21,7 @@ fn query(response: ResponseType) -> Query {
             difficulty: Difficulty::Hard,
             distraction: Distraction::Easy,
         },
-        actions: ActionSpace::feeding(),
+        actions: hil_envs::feeding::action_space(),
         context: Context::new(vec![0.5, 0.5]).unwrap(),
         oracle_best: Some(ArmId(5)),
     }

@@ -17,8 +17,8 @@ use std::time::{Duration, Instant};
 
 use hil_channels::{WebChannel, WebChannelConfig};
 use hil_core::{
-    ActionSpace, Answer, ArmId, Context, Difficulty, Distraction, Item, Query, QueryChannel,
-    QueryKind, Response, ResponseType,
+    Answer, ArmId, Context, Difficulty, Distraction, Item, Query, QueryChannel, QueryKind,
+    Response, ResponseType,
 };
 use serde_json::{Value, json};
 
@@ -271,7 +271,7 @@ fn query(t: u64, response: ResponseType) -> Query {
             difficulty: Difficulty::Hard,
             distraction: Distraction::Easy,
         },
-        actions: ActionSpace::feeding(),
+        actions: hil_envs::feeding::action_space(),
         context: Context::new(vec![0.0]).unwrap(),
         oracle_best: Some(ArmId(5)),
     }

@@ -11,8 +11,7 @@ use std::time::Duration;
 use hil_channels::{WebChannel, WebChannelConfig};
 use hil_core::testing::check_query_channel;
 use hil_core::{
-    ActionSpace, Answer, ArmId, Context, Item, Query, QueryChannel, QueryKind, Response,
-    ResponseType,
+    Answer, ArmId, Context, Item, Query, QueryChannel, QueryKind, Response, ResponseType,
 };
 
 fn channel(timeout_s: f64) -> (WebChannel, SocketAddr, String) {
@@ -89,7 +88,7 @@ fn query(t: u64, response: ResponseType) -> Query {
             response,
             ..Default::default()
         },
-        actions: ActionSpace::feeding(),
+        actions: hil_envs::feeding::action_space(),
         context: Context::new(vec![0.1]).unwrap(),
         oracle_best: Some(ArmId(1)),
     }

@@ -26,19 +26,18 @@ impl std::fmt::Display for ArmId {
 ///
 /// ```
 /// use hil_core::{ActionSpace, ArmId};
-/// let space = ActionSpace::feeding();
-/// assert_eq!(space.len(), 6);
-/// assert_eq!(space.name(ArmId(4)).unwrap(), "TA0");
-/// assert_eq!(space.find("TV90"), Some(ArmId(3)));
+/// let space = ActionSpace::new(["grasp_top", "grasp_side", "push"]).unwrap();
+/// assert_eq!(space.len(), 3);
+/// assert_eq!(space.name(ArmId(2)).unwrap(), "push");
+/// assert_eq!(space.find("grasp_side"), Some(ArmId(1)));
 /// ```
+///
+/// Tasks define their own spaces (the feeding task's six skewering actions
+/// live with the feeding data in `hil-envs`).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ActionSpace {
     names: Vec<String>,
 }
-
-/// The six skewering actions of the feeding task: pitch (vertical skewer,
-/// tilted vertical, tilted angled) × roll (0° or 90° to the food's major axis).
-pub const FEEDING_ACTIONS: [&str; 6] = ["VS0", "VS90", "TV0", "TV90", "TA0", "TA90"];
 
 impl ActionSpace {
     /// Builds an action space from unique, non-empty names.
@@ -62,13 +61,6 @@ impl ActionSpace {
             }
         }
         Ok(Self { names })
-    }
-
-    /// The feeding task's six actions, [`FEEDING_ACTIONS`].
-    pub fn feeding() -> Self {
-        Self {
-            names: FEEDING_ACTIONS.iter().map(|s| s.to_string()).collect(),
-        }
     }
 
     /// Number of robot actions.

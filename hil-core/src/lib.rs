@@ -10,7 +10,8 @@
 //!   [`Timestep`]/[`TimeGrid`].
 //! - The four traits: [`Policy`], [`WorkloadModel`], [`QueryChannel`],
 //!   [`Environment`]; object-safe, so they can be named in configs and
-//!   cross plugin boundaries.
+//!   cross plugin boundaries. [`CallOrder`] is the environments' shared
+//!   call-order check; [`PerfectExpert`] is the paper's perfect expert.
 //! - The loop: [`Session`] runs episodes with the paper's semantics and
 //!   emits one [`StepEvent`] per step; [`EpisodeMetrics`] computes the
 //!   paper's metrics from those events.
@@ -42,12 +43,12 @@ pub mod workload;
 #[cfg(feature = "testing")]
 pub mod testing;
 
-pub use action::{ActionSpace, ArmId, FEEDING_ACTIONS};
-pub use channel::QueryChannel;
+pub use action::{ActionSpace, ArmId};
+pub use channel::{PerfectExpert, QueryChannel};
 pub use config::{BuildContext, BuildMemo, ConfigError, ExperimentConfig};
 pub use context::Context;
 pub use decision::{ArmDiagnostics, Choice, Decision, Diagnostics, LabelledObservation, Outcome};
-pub use environment::{Environment, Item};
+pub use environment::{CallOrder, Environment, Item};
 pub use error::{HilError, Result};
 pub use experiment::{Experiment, ExperimentSummary};
 pub use metrics::EpisodeMetrics;

@@ -4,8 +4,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
+use hil_core::channel::PerfectExpert;
 use hil_core::config::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
-use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, ScriptedPolicy, TableEnv};
+use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::{
     ActionSpace, ArmId, BuildContext, Choice, Environment, ExperimentConfig, HilError, Policy,
     QueryChannel, QueryKind, WorkloadModel,
@@ -88,7 +89,7 @@ struct OracleConfig {}
 #[typetag::serde(name = "test_oracle")]
 impl QueryChannelConfig for OracleConfig {
     fn build(&self, _ctx: &BuildContext) -> hil_core::Result<Box<dyn QueryChannel>> {
-        Ok(Box::new(OracleChannel::default()))
+        Ok(Box::new(PerfectExpert::default()))
     }
 }
 

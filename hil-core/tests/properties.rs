@@ -2,7 +2,9 @@
 
 use std::sync::Arc;
 
-use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, ScriptedPolicy, TableEnv};
+use hil_core::channel::PerfectExpert;
+
+use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::testing::strategies;
 use hil_core::{ActionSpace, ArmId, Choice, QueryKind, Session, SessionSettings, StepDecision};
 use proptest::prelude::*;
@@ -32,7 +34,7 @@ proptest! {
         let mut env = TableEnv::new(ActionSpace::new(["A", "B", "C"]).unwrap(), items).unwrap();
         let dim = hil_core::Environment::context_dim(&env);
         let mut policy = ScriptedPolicy::new(3, dim, script);
-        let mut channel = OracleChannel::default();
+        let mut channel = PerfectExpert::default();
         let mut s = Session {
             settings: SessionSettings { n_att, wl0: 0.5, max_items: None },
             environment: &mut env,

@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
+use hil_core::channel::PerfectExpert;
 use hil_core::record::{Header, Record, RecordLog, run_recorded};
-use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, ScriptedPolicy, TableEnv};
+use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::{
     ActionSpace, Answer, ArmId, Choice, Experiment, HilError, Query, QueryChannel, QueryKind,
     Response, ResponseType, SessionSettings,
@@ -43,7 +44,7 @@ impl QueryChannel for Person {
         if q.t % 3 == 0 {
             return Ok(Response::without_action(Answer::Declined));
         }
-        let mut r = OracleChannel::default().ask(q)?;
+        let mut r = PerfectExpert::default().ask(q)?;
         r.response_time_s = Some(0.1 * q.t as f64 + 1.0 / 3.0);
         Ok(r)
     }

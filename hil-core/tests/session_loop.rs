@@ -2,7 +2,9 @@
 
 use std::sync::Arc;
 
-use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, ScriptedPolicy, TableEnv};
+use hil_core::channel::PerfectExpert;
+
+use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::{
     ActionSpace, Answer, ArmId, Choice, EpisodeReport, EventCollector, Query, QueryChannel,
     QueryKind, Response, Session, SessionObserver, SessionSettings, StepDecision,
@@ -77,7 +79,7 @@ fn hand_worked_episode() {
         dim,
         vec![act(0), query(0), act(0), act(2), act(2), act(1)],
     );
-    let mut channel = OracleChannel::default();
+    let mut channel = PerfectExpert::default();
     let mut collector = EventCollector::default();
     let report = episode(
         &mut env,
@@ -155,7 +157,7 @@ fn expert_action_is_repeated_until_success() {
         .unwrap()
         .with_outcomes(vec![false, false, false, false, true]);
     let mut policy = ScriptedPolicy::new(3, 3, vec![query(2), act(0)]);
-    let mut channel = OracleChannel::default();
+    let mut channel = PerfectExpert::default();
     let r = episode(
         &mut env,
         &mut policy,
@@ -184,7 +186,7 @@ fn item_ends_after_n_att_attempts() {
     )
     .unwrap();
     let mut policy = ScriptedPolicy::new(3, 4, vec![act(0)]);
-    let mut channel = OracleChannel::default();
+    let mut channel = PerfectExpert::default();
     for n_att in [1, 4, 10] {
         let r = episode(
             &mut env,
@@ -261,7 +263,7 @@ fn seeded_episodes_replay_exactly() {
         )
         .unwrap();
         let mut policy = ScriptedPolicy::new(3, 4, vec![act(0), act(1), query(2), act(2)]);
-        let mut channel = OracleChannel::default();
+        let mut channel = PerfectExpert::default();
         episode(
             &mut env,
             &mut policy,
@@ -280,7 +282,7 @@ fn seeded_episodes_replay_exactly() {
 fn shape_mismatch_is_an_error() {
     let mut env = TableEnv::new(actions(), vec![("a", vec![0.3, 0.5, 0.7])]).unwrap();
     let mut policy = ScriptedPolicy::new(3, 99, vec![act(0)]);
-    let mut channel = OracleChannel::default();
+    let mut channel = PerfectExpert::default();
     let mut s = Session {
         settings: SessionSettings::default(),
         environment: &mut env,
@@ -317,7 +319,7 @@ fn fixtures_pass_their_conformance_suites() {
     .unwrap();
     assert!(r.passed.contains(&"checkpoint"), "{r:?}");
     check_workload_model(&CountingWorkload::new(0.05)).unwrap();
-    check_query_channel(&mut OracleChannel::default(), 20).unwrap();
+    check_query_channel(&mut PerfectExpert::default(), 20).unwrap();
 }
 
 #[test]
@@ -447,7 +449,7 @@ fn explicit_component_seeds_reach_each_component() {
         )
         .unwrap();
         let mut policy = ScriptedPolicy::new(3, 4, vec![act(0), act(1), act(2)]);
-        let mut channel = OracleChannel::default();
+        let mut channel = PerfectExpert::default();
         let seeds = hil_core::session::ComponentSeeds {
             environment: env_seed,
             policy: 1,

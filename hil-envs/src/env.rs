@@ -6,7 +6,8 @@ use std::sync::Arc;
 use hil_core::config::{BuildContext, EnvironmentConfig};
 use hil_core::session::splitmix;
 use hil_core::{
-    ActionSpace, ArmId, Context, Environment, HilError, Item, LabelledObservation, Outcome, Result,
+    ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, LabelledObservation,
+    Outcome, Result,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -62,8 +63,10 @@ pub struct DatasetReplayEnv {
     next: usize,
     current: Option<Item>,
     attempt: u64,
+    /// The image and uniform draw of the last observation, until executed.
     observed: Option<(usize, f64)>,
     last_image: Option<usize>,
+    calls: CallOrder,
 }
 
 impl DatasetReplayEnv {
@@ -98,6 +101,7 @@ impl DatasetReplayEnv {
             attempt: 0,
             observed: None,
             last_image: None,
+            calls: CallOrder::new("food_replay"),
         })
     }
 
@@ -163,6 +167,7 @@ impl Environment for DatasetReplayEnv {
         self.current = None;
         self.observed = None;
         self.last_image = None;
+        self.calls.on_reset();
         Ok(())
     }
 
@@ -170,6 +175,7 @@ impl Environment for DatasetReplayEnv {
         self.observed = None;
         if self.next >= self.sequence.len() {
             self.current = None;
+            self.calls.on_next_item(false);
             return Ok(None);
         }
         let item = Item {
@@ -180,10 +186,12 @@ impl Environment for DatasetReplayEnv {
         self.next += 1;
         self.attempt = 0;
         self.current = Some(item.clone());
+        self.calls.on_next_item(true);
         Ok(Some(item))
     }
 
     fn observe(&mut self) -> Result<Context> {
+        self.calls.on_observe()?;
         let f = self.current_food()?;
         let index = self.current.as_ref().map_or(0, |i| i.index) as u64;
         // One stream per (item, attempt): common random numbers across policies.
@@ -200,6 +208,7 @@ impl Environment for DatasetReplayEnv {
 
     fn execute(&mut self, arm: ArmId) -> Result<Outcome> {
         self.dataset.actions.check(arm)?;
+        self.calls.on_execute()?;
         let f = self.current_food()?;
         let (i, u) = self.observed.take().ok_or_else(|| {
             HilError::state(

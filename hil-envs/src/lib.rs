@@ -4,10 +4,16 @@
 //!
 //! - [`dataset`]: the food dataset format (a TOML manifest plus NumPy `.npy`
 //!   arrays), its validating loader and writer; [`npy`]: the `.npy` codec;
-//! - [`rates`]: the published per-food success rates the bundled data is
-//!   calibrated to; [`generate`]: the seeded synthetic dataset generator;
+//! - [`feeding`]: the feeding task's vocabulary and facts, defined once as
+//!   data (actions, placement settings, foods with descriptions, published
+//!   per-food success rates), shared by every crate that needs them;
+//! - [`rates`]: the parser of the published per-food success rates the
+//!   bundled data is calibrated to; [`generate`]: the seeded synthetic
+//!   dataset generator;
 //! - [`DatasetReplayEnv`]: the dataset-replay [`hil_core::Environment`]
 //!   (config type `food_replay`);
+//! - [`demo_plate`]: a small plate of foods for trying the channels without
+//!   a robot (config type `demo_plate`);
 //! - [`split`]: food-level pretrain / validation / test splits.
 //!
 //! The paper's protocol that runs on this environment, with its tables and
@@ -18,7 +24,9 @@
 //! results.
 
 pub mod dataset;
+pub mod demo_plate;
 pub mod env;
+pub mod feeding;
 pub mod generate;
 pub mod npy;
 pub mod rates;
@@ -27,6 +35,7 @@ pub mod split;
 use std::sync::{Arc, OnceLock};
 
 pub use dataset::{Food, FoodDataset, FoodImage};
+pub use demo_plate::{DemoPlate, DemoPlateConfig};
 pub use env::{DatasetReplayEnv, FoodReplayConfig, OutcomeMode, PretrainReward};
 pub use split::FoodSplit;
 

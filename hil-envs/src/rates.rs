@@ -178,7 +178,7 @@ mod tests {
     #[test]
     fn bundled_table_is_complete_and_pooled_rows_are_setting_means() {
         let r = PublishedRates::bundled().unwrap();
-        assert_eq!(r.actions, hil_core::FEEDING_ACTIONS);
+        assert_eq!(r.actions, crate::feeding::action_space().names());
         assert_eq!(r.foods.len(), 16);
         for f in &r.foods {
             for a in 0..6 {
@@ -197,17 +197,27 @@ mod tests {
     #[test]
     fn errors_name_line_and_field() {
         let p = Path::new("r.csv");
-        let e = PublishedRates::parse("food,setting,A\nx,iso,1.5\nx,all,1\n", p)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("r.csv:2") && e.contains("`A`"), "{e}");
-        let e = PublishedRates::parse("food,setting,A\nx,iso,0.5\n", p)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("no `all` row"), "{e}");
-        let e = PublishedRates::parse("food,setting,A\nx,iso,0.5\nx,iso,0.2\nx,all,1\n", p)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("r.csv:3") && e.contains("second row"), "{e}");
+        let at = |text: &str| match PublishedRates::parse(text, p) {
+            Err(HilError::Data {
+                path,
+                record,
+                field,
+                ..
+            }) => (path, record, field),
+            other => panic!("expected a data error, got {other:?}"),
+        };
+        assert_eq!(
+            at("food,setting,A\nx,iso,1.5\nx,all,1\n"),
+            (p.to_path_buf(), 2, "A".to_string())
+        );
+        assert_eq!(
+            at("food,setting,A\nx,iso,0.5\n"),
+            (p.to_path_buf(), 0, "setting".to_string())
+        );
+        assert_eq!(
+            at("food,setting,A\nx,iso,0.5\nx,iso,0.2\nx,all,1\n"),
+            (p.to_path_buf(), 3, "setting".to_string())
+        );
+        assert_eq!(at(""), (p.to_path_buf(), 1, "header".to_string()));
     }
 }

@@ -502,7 +502,7 @@ impl std::fmt::Debug for Protocol {
 
 /// The paper's simulated expert for [`Protocol::channel`].
 pub fn perfect_expert() -> Box<dyn QueryChannel> {
-    Box::new(hil_channels::SimulatedExpert::perfect())
+    Box::new(hil_core::PerfectExpert::default())
 }
 
 impl Protocol {

@@ -22,7 +22,7 @@ use crate::model::SceneIds;
 /// One skewering action.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Action {
-    /// Label (VS0 ... TA90), the `FEEDING_ACTIONS` order of hil-core.
+    /// Label (VS0 ... TA90), in the order of `hil_envs::feeding::action_space`.
     pub name: &'static str,
     /// Fork pitch β (rad).
     pub pitch: f64,

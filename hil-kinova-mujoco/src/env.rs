@@ -20,7 +20,8 @@ use std::sync::Arc;
 
 use hil_core::config::{BuildContext, EnvironmentConfig};
 use hil_core::{
-    ActionSpace, ArmId, Context, Environment, HilError, Item, LabelledObservation, Outcome, Result,
+    ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, LabelledObservation,
+    Outcome, Result,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -220,6 +221,7 @@ pub struct KinovaFeedingEnv {
     cursor: usize,
     current: Option<Current>,
     last: Option<AttemptReport>,
+    calls: CallOrder,
 }
 
 impl KinovaFeedingEnv {
@@ -239,11 +241,12 @@ impl KinovaFeedingEnv {
                 .collect(),
             embedding: Embedding::new(cfg.context_dim, cfg.embedding_seed),
             sim,
-            actions: ActionSpace::feeding(),
+            actions: hil_envs::feeding::action_space(),
             rng: ChaCha8Rng::seed_from_u64(0),
             cursor: 0,
             current: None,
             last: None,
+            calls: CallOrder::new("kinova_feeding"),
             cfg,
         })
     }
@@ -270,6 +273,7 @@ impl KinovaFeedingEnv {
         keyframe: Option<KeyframeHook<'_>>,
     ) -> Result<Outcome> {
         self.actions.check(arm)?;
+        self.calls.on_execute()?;
         let cur = self
             .current
             .as_mut()
@@ -402,25 +406,22 @@ impl Environment for KinovaFeedingEnv {
         self.cursor = 0;
         self.current = None;
         self.last = None;
+        self.calls.on_reset();
         Ok(())
     }
 
     fn next_item(&mut self) -> Result<Option<Item>> {
         let Some(&kind) = self.foods.get(self.cursor) else {
             self.current = None;
+            self.calls.on_next_item(false);
             return Ok(None);
         };
         let props = self.models[kind.index()].sample(&mut self.rng);
         let setting = self.settings[self.rng.random_range(0..self.settings.len())];
-        let where_ = match setting {
-            Setting::Isolated => "alone on the plate",
-            Setting::Wall => "against the plate's rim",
-            Setting::Lettuce => "on a lettuce leaf",
-        };
         let item = Item {
             index: self.cursor,
             label: kind.name().to_string(),
-            description: Some(format!("a {} {where_}", kind.name())),
+            description: Some(format!("{} {}", kind.description(), setting.description())),
         };
         self.cursor += 1;
         self.current = Some(Current {
@@ -429,10 +430,12 @@ impl Environment for KinovaFeedingEnv {
             setting,
             observation: None,
         });
+        self.calls.on_next_item(true);
         Ok(Some(item))
     }
 
     fn observe(&mut self) -> Result<Context> {
+        self.calls.on_observe()?;
         let (props, setting) = match &self.current {
             Some(c) => (c.props.clone(), c.setting),
             None => {

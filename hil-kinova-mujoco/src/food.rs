@@ -14,6 +14,8 @@ use rand::Rng;
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
+use hil_envs::feeding::{FeedingTask, FoodFacts};
+
 /// A kind of food the scene holds (one MuJoCo body each).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
 #[serde(rename_all = "snake_case")]
@@ -59,38 +61,45 @@ impl FoodKind {
         format!("food_{}_geom", self.name())
     }
 
-    /// Published success rates (Feng et al. 2019, setting `all`: the mean
-    /// of the three settings) in the order VS0 VS90 TV0 TV90 TA0 TA90.
-    pub fn published_rates(self) -> [f64; 6] {
-        match self {
-            FoodKind::Banana => [0.2, 0.2, 0.1, 0.1, 0.57, 0.57],
-            FoodKind::Carrot => [0.0, 0.53, 0.0, 0.43, 0.0, 0.03],
-            FoodKind::Cantaloupe => [0.77, 0.93, 0.7, 0.8, 0.3, 0.27],
+    /// The published facts of this food (rates, description), from the
+    /// feeding data of `hil-envs`.
+    pub fn facts(self) -> &'static FoodFacts {
+        match FeedingTask::bundled().food(self.name()) {
+            Some(f) => f,
+            // Every kind is one of the 16 published foods; a test checks it.
+            None => unreachable!("`{}` is missing from the feeding data", self.name()),
         }
+    }
+
+    /// Published success rates (Feng et al. 2019, setting `all`: the mean
+    /// of the three settings), one per action of
+    /// [`hil_envs::feeding::action_space`] (VS0 VS90 TV0 TV90 TA0 TA90).
+    pub fn published_rates(self) -> &'static [f64] {
+        &self.facts().pooled
     }
 
     /// Published success rates in one placement setting (10 trials per
     /// cell in the source), same order as [`published_rates`](Self::published_rates).
-    pub fn published_rates_in(self, setting: Setting) -> [f64; 6] {
-        use Setting::*;
-        match (self, setting) {
-            (FoodKind::Banana, Isolated) => [0.0, 0.0, 0.0, 0.0, 0.2, 0.2],
-            (FoodKind::Banana, Wall) => [0.0, 0.0, 0.0, 0.0, 0.9, 0.9],
-            (FoodKind::Banana, Lettuce) => [0.6, 0.6, 0.3, 0.3, 0.6, 0.6],
-            (FoodKind::Carrot, Isolated) => [0.0, 1.0, 0.0, 0.8, 0.0, 0.0],
-            (FoodKind::Carrot, Wall) => [0.0, 0.4, 0.0, 0.3, 0.0, 0.1],
-            (FoodKind::Carrot, Lettuce) => [0.0, 0.2, 0.0, 0.2, 0.0, 0.0],
-            (FoodKind::Cantaloupe, Isolated) => [0.9, 1.0, 1.0, 0.7, 0.0, 0.0],
-            (FoodKind::Cantaloupe, Wall) => [0.8, 0.9, 0.7, 0.9, 0.4, 0.6],
-            (FoodKind::Cantaloupe, Lettuce) => [0.6, 0.9, 0.4, 0.8, 0.5, 0.2],
+    pub fn published_rates_in(self, setting: Setting) -> &'static [f64] {
+        match self.facts().rates_in(setting.name()) {
+            Some(r) => r,
+            // Every setting is one of the published three; a test checks it.
+            None => unreachable!(
+                "setting `{}` is missing from the feeding data",
+                setting.name()
+            ),
         }
+    }
+
+    /// How a person is told about an item of this kind (`a baby carrot`).
+    pub fn description(self) -> &'static str {
+        &self.facts().description
     }
 
     /// The action a knowledgeable caregiver names for this food: the best
     /// published action (ties broken towards the lower index).
     pub fn expert_action(self) -> usize {
-        let r = self.published_rates();
-        (0..6).fold(0, |b, i| if r[i] > r[b] { i } else { b })
+        self.facts().best_action().0
     }
 
     /// Nominal colour (RGB in [0, 1]) a camera sees.
@@ -132,6 +141,16 @@ impl Setting {
     /// Parses a label (`isolated`, `wall`, `lettuce`).
     pub fn parse(s: &str) -> Option<Self> {
         parse_label(s)
+    }
+
+    /// Where an item in this setting lies, from the feeding data of
+    /// `hil-envs` (`against the plate's rim`).
+    pub fn description(self) -> &'static str {
+        match FeedingTask::bundled().setting_description(self.name()) {
+            Some(d) => d,
+            // Every setting is one of the published three; a test checks it.
+            None => unreachable!("setting `{}` is missing from the feeding data", self.name()),
+        }
     }
 }
 
@@ -550,5 +569,26 @@ mod tests {
             }
         }
         assert_eq!(Setting::parse("wall"), Some(Setting::Wall));
+    }
+
+    #[test]
+    fn every_kind_and_setting_is_in_the_feeding_data() {
+        for kind in FoodKind::ALL {
+            assert_eq!(kind.published_rates().len(), 6);
+            assert!(!kind.description().is_empty());
+            for s in Setting::ALL {
+                assert_eq!(kind.published_rates_in(s).len(), 6);
+                assert!(!s.description().is_empty());
+            }
+        }
+        assert_eq!(FoodKind::Banana.published_rates()[4], 0.57);
+        assert_eq!(
+            FoodKind::Carrot.published_rates_in(Setting::Isolated)[1],
+            1.0
+        );
+        assert_eq!(
+            FoodKind::Cantaloupe.published_rates_in(Setting::Wall)[5],
+            0.6
+        );
     }
 }

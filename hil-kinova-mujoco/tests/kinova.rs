@@ -4,8 +4,9 @@
 
 use std::sync::Arc;
 
+use hil_core::channel::PerfectExpert;
 use hil_core::testing::check_environment;
-use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, ScriptedPolicy};
+use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy};
 use hil_core::{
     ArmId, Choice, Difficulty, Distraction, Environment, QueryKind, ResponseType, Session,
     SessionSettings,
@@ -139,7 +140,7 @@ fn a_short_episode_runs_through_the_session_loop() {
     };
     // Ask about the first item, then act on its own with TA0.
     let mut policy = ScriptedPolicy::new(6, 16, vec![query, Choice::Act { arm: ArmId(4) }]);
-    let mut channel = OracleChannel::default();
+    let mut channel = PerfectExpert::default();
     let mut session = Session {
         settings: SessionSettings {
             n_att: 2,

@@ -32,6 +32,7 @@
 mod always_query;
 mod common;
 mod config;
+pub mod demo_learner;
 pub mod estimator;
 mod exp_decay;
 mod linucb;

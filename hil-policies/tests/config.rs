@@ -79,7 +79,7 @@ fn missing_and_mistyped_fields_are_named() {
 #[test]
 fn bad_values_are_invalid_parameters() {
     let mut ctx = BuildContext::new(".", 0);
-    ctx.action_space = Some(ActionSpace::feeding());
+    ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
     ctx.context_dim = Some(3);
     for (body, field) in [
         ("type = \"linucb_qg\"\nalpha = 0.5\nw = -1.0", "w"),

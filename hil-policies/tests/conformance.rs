@@ -89,7 +89,7 @@ struct Wrapper {
 
 fn ctx(pretrain: bool) -> BuildContext {
     let mut c = BuildContext::new(".", 3);
-    c.action_space = Some(ActionSpace::feeding());
+    c.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
     c.context_dim = Some(DIM);
     if pretrain {
         c.pretraining = Some(Arc::from(pretraining()));

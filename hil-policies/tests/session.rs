@@ -3,7 +3,8 @@
 
 use std::sync::Arc;
 
-use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, TableEnv};
+use hil_core::PerfectExpert;
+use hil_core::testing::fixtures::{CountingWorkload, TableEnv};
 use hil_core::{
     ActionSpace, ArmId, EpisodeReport, Policy, QueryKind, Session, SessionSettings, StepDecision,
 };
@@ -24,7 +25,7 @@ fn env() -> TableEnv {
 
 fn run(policy: &mut dyn Policy, seed: u64) -> EpisodeReport {
     let mut env = env();
-    let mut channel = OracleChannel::default();
+    let mut channel = PerfectExpert::default();
     let mut s = Session {
         settings: SessionSettings {
             n_att: 4,

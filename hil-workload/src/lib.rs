@@ -14,6 +14,7 @@
 //! - [`select`]: nested cross-validation and the appendix table;
 //! - [`stats`]: Mann-Whitney U and Wilcoxon signed-rank tests;
 //! - [`synth`]: a synthetic study calibrated to the paper's figures;
+//! - [`demo_counting`]: a simple counting model for demos (`demo_counting`);
 //! - [`bundled`]: the shipped models (`f1_sim`, …) and [`config`] types.
 //!
 //! Bundled data and models are synthetic, calibrated to published figures.
@@ -31,6 +32,7 @@ pub mod bundle;
 pub mod bundled;
 pub mod config;
 pub mod datasets;
+pub mod demo_counting;
 pub mod features;
 pub mod fit;
 pub mod models;

@@ -49,7 +49,7 @@ fn bench(c: &mut Criterion) {
     .unwrap();
     let h = QueryHistory::new();
     let mut ctx = BuildContext::new(".", 3);
-    ctx.action_space = Some(ActionSpace::feeding());
+    ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
     ctx.context_dim = Some(dim);
 
     let mut g = c.benchmark_group("decide, trivial policy (d = 32)");

@@ -11,7 +11,7 @@ use hil_core::{ActionSpace, BuildContext, HilError};
 
 fn ctx() -> BuildContext {
     let mut ctx = BuildContext::new(".", 5);
-    ctx.action_space = Some(ActionSpace::feeding());
+    ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
     ctx.context_dim = Some(4);
     ctx
 }

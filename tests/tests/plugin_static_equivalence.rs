@@ -6,15 +6,16 @@ mod common;
 
 use std::sync::Arc;
 
+use hil_core::channel::PerfectExpert;
 use hil_core::plugin::{self, Params};
-use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, TableEnv};
-use hil_core::{ActionSpace, BuildContext, EpisodeReport, Policy, Session, SessionSettings};
+use hil_core::testing::fixtures::{CountingWorkload, TableEnv};
+use hil_core::{BuildContext, EpisodeReport, Policy, Session, SessionSettings};
 
 const PARAMS: &str = "v = 0.4\nsamples = 12\nconfidence = 0.6\nmax_workload = 0.9";
 
 fn env() -> TableEnv {
     TableEnv::new(
-        ActionSpace::feeding(),
+        hil_envs::feeding::action_space(),
         vec![
             ("banana", vec![0.2, 0.3, 0.9, 0.4, 0.1, 0.5]),
             ("carrot", vec![0.8, 0.2, 0.1, 0.3, 0.6, 0.2]),
@@ -29,14 +30,14 @@ fn env() -> TableEnv {
 
 fn ctx(dim: usize) -> BuildContext {
     let mut ctx = BuildContext::new(".", 11);
-    ctx.action_space = Some(ActionSpace::feeding());
+    ctx.action_space = Some(hil_envs::feeding::action_space());
     ctx.context_dim = Some(dim);
     ctx
 }
 
 fn episodes(policy: &mut dyn Policy, n: usize) -> Vec<EpisodeReport> {
     let mut env = env();
-    let mut channel = OracleChannel::default();
+    let mut channel = PerfectExpert::default();
     let workload = Arc::new(CountingWorkload::new(0.05));
     (0..n as u64)
         .map(|k| {

@@ -67,7 +67,7 @@ fn the_guide_plugin_loads_conforms_and_runs_from_the_guide_config() {
 
     // What `hil plugins check` does.
     let mut ctx = BuildContext::new(".", 0);
-    ctx.action_space = Some(ActionSpace::feeding());
+    ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
     ctx.context_dim = Some(8);
     let params = Params::toml("n_ask = 2");
     hil_core::testing::check_policy(&|| plugin::build_policy("ask_first_items", &params, &ctx))
@@ -94,9 +94,7 @@ fn the_guide_plugin_loads_conforms_and_runs_from_the_guide_config() {
     );
     plugin::register_static(Path::new("guide-test-oracle"), |r| {
         r.query_channel("guide_oracle", "a perfect expert", |_, _| {
-            Ok(Box::new(
-                hil_core::testing::fixtures::OracleChannel::default(),
-            ))
+            Ok(Box::new(hil_core::channel::PerfectExpert::default()))
         });
     })
     .unwrap();

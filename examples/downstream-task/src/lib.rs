@@ -28,7 +28,8 @@ use serde::{Deserialize, Serialize};
 
 use hil_core::config::EnvironmentConfig;
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Context, Environment, HilError, Item, Outcome, Result,
+    ActionSpace, ArmId, BuildContext, CallOrder, Context, Environment, HilError, Item, Outcome,
+    Result,
 };
 
 /// Handover poses, in arm order.
@@ -72,7 +73,7 @@ pub struct CupHandover {
     next: usize,
     /// (item, posture features, success probability per pose)
     current: Option<(Item, [f64; 4], [f64; 5])>,
-    observed: bool,
+    calls: CallOrder,
 }
 
 impl CupHandover {
@@ -91,7 +92,7 @@ impl CupHandover {
             rng: ChaCha8Rng::seed_from_u64(0),
             next: 0,
             current: None,
-            observed: false,
+            calls: CallOrder::new("cup_handover"),
         })
     }
 
@@ -131,13 +132,13 @@ impl Environment for CupHandover {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
         self.next = 0;
         self.current = None;
-        self.observed = false;
+        self.calls.on_reset();
         Ok(())
     }
     fn next_item(&mut self) -> Result<Option<Item>> {
-        self.observed = false;
         if self.next >= self.handovers {
             self.current = None;
+            self.calls.on_next_item(false);
             return Ok(None);
         }
         let posture = [
@@ -153,9 +154,11 @@ impl Environment for CupHandover {
         };
         self.next += 1;
         self.current = Some((item.clone(), posture, Self::probabilities(&posture)));
+        self.calls.on_next_item(true);
         Ok(Some(item))
     }
     fn observe(&mut self) -> Result<Context> {
+        self.calls.on_observe()?;
         let (_, posture, _) = self.current.as_ref().ok_or_else(|| {
             HilError::state("cup_handover", "no current handover: call next_item first")
         })?;
@@ -164,14 +167,11 @@ impl Environment for CupHandover {
             .iter()
             .map(|v| v + 0.05 * (self.rng.random::<f64>() - 0.5))
             .collect();
-        self.observed = true;
         Context::new(x)
     }
     fn execute(&mut self, arm: ArmId) -> Result<Outcome> {
         self.actions.check(arm)?;
-        if !self.observed {
-            return Err(HilError::state("cup_handover", "execute before observe"));
-        }
+        self.calls.on_execute()?;
         let p = self
             .current
             .as_ref()
@@ -196,7 +196,8 @@ impl Environment for CupHandover {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hil_core::testing::fixtures::{CountingWorkload, OracleChannel, ScriptedPolicy};
+    use hil_core::channel::PerfectExpert;
+    use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy};
     use hil_core::{Choice, QueryKind, Session, SessionSettings};
     use std::sync::Arc;
 
@@ -220,7 +221,7 @@ mod tests {
                 fallback: ArmId(0),
             }],
         );
-        let mut channel = OracleChannel::default();
+        let mut channel = PerfectExpert::default();
         let mut session = Session {
             settings: SessionSettings::default(),
             environment: &mut env,

@@ -25,7 +25,8 @@ use serde::{Deserialize, Serialize};
 
 use hil_core::plugin::{Params, Registrar};
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Context, Environment, HilError, Item, Outcome, Result,
+    ActionSpace, ArmId, BuildContext, CallOrder, Context, Environment, HilError, Item, Outcome,
+    Result,
 };
 
 /// The name the plugin registers.
@@ -118,7 +119,7 @@ pub struct GraspEnv {
     rng: ChaCha8Rng,
     next: usize,
     current: Option<(Item, usize)>,
-    observed: bool,
+    calls: CallOrder,
 }
 
 impl GraspEnv {
@@ -170,7 +171,7 @@ impl GraspEnv {
             rng: ChaCha8Rng::seed_from_u64(0),
             next: 0,
             current: None,
-            observed: false,
+            calls: CallOrder::new(NAME),
         })
     }
 
@@ -196,13 +197,13 @@ impl Environment for GraspEnv {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
         self.next = 0;
         self.current = None;
-        self.observed = false;
+        self.calls.on_reset();
         Ok(())
     }
     fn next_item(&mut self) -> Result<Option<Item>> {
-        self.observed = false;
         if self.next >= self.p.n_objects {
             self.current = None;
+            self.calls.on_next_item(false);
             return Ok(None);
         }
         let obj = self.pool[self.rng.random_range(0..self.pool.len())];
@@ -216,9 +217,11 @@ impl Environment for GraspEnv {
         };
         self.next += 1;
         self.current = Some((item.clone(), obj));
+        self.calls.on_next_item(true);
         Ok(Some(item))
     }
     fn observe(&mut self) -> Result<Context> {
+        self.calls.on_observe()?;
         let obj = self.object()?;
         let s = self.p.noise;
         let mut x: Vec<f64> = OBJECTS[obj]
@@ -229,15 +232,12 @@ impl Environment for GraspEnv {
         // Pose: yaw and distance offsets the grasp planner would see.
         x.push(self.rng.random_range(-1.0..1.0));
         x.push(self.rng.random_range(-1.0..1.0));
-        self.observed = true;
         Context::new(x)
     }
     fn execute(&mut self, arm: ArmId) -> Result<Outcome> {
         self.actions.check(arm)?;
+        self.calls.on_execute()?;
         let obj = self.object()?;
-        if !self.observed {
-            return Err(HilError::state(NAME, "execute before observe"));
-        }
         let p = OBJECTS[obj].2[arm.0];
         Ok(Outcome {
             success: self.rng.random_bool(p),

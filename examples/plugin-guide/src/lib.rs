@@ -120,7 +120,7 @@ mod tests {
     #[test]
     fn conforms() {
         let mut ctx = BuildContext::new(".", 0);
-        ctx.action_space = Some(ActionSpace::feeding());
+        ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
         ctx.context_dim = Some(4);
         let params = Params::toml("n_ask = 2");
         hil_core::testing::check_policy(&|| build(&params, &ctx)).unwrap();

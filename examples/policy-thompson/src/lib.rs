@@ -19,7 +19,7 @@
 //! use hil_core::{ActionSpace, BuildContext, Policy};
 //! use hil_core::plugin::Params;
 //! let mut ctx = BuildContext::new(".", 7);
-//! ctx.action_space = Some(ActionSpace::feeding());
+//! ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
 //! ctx.context_dim = Some(4);
 //! let p = hil_example_policy_thompson::build(&Params::toml("confidence = 0.7"), &ctx).unwrap();
 //! assert_eq!((p.n_arms(), p.dim()), (6, 4));
@@ -345,7 +345,7 @@ mod tests {
 
     fn ctx() -> BuildContext {
         let mut ctx = BuildContext::new(".", 3);
-        ctx.action_space = Some(ActionSpace::feeding());
+        ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
         ctx.context_dim = Some(5);
         ctx
     }

@@ -211,7 +211,7 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     println!("Simulated attempts with synthetic food properties; published: Feng et al. 2019.");
     let header = || {
         print!("{:<22}", "food");
-        for a in hil_core::FEEDING_ACTIONS {
+        for a in hil_envs::feeding::action_space().names() {
             print!("{a:>13}");
         }
         println!();

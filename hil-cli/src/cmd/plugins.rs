@@ -216,7 +216,9 @@ fn check_one(
     attempts: u32,
 ) -> Result<ConformanceReport, String> {
     let mut ctx = BuildContext::new(".", 0);
-    ctx.action_space = Some(ActionSpace::feeding());
+    ctx.action_space = Some(ActionSpace::clone(
+        hil_envs::feeding::FeedingTask::bundled().action_space(),
+    ));
     ctx.context_dim = Some(dim);
     let name = c.name.as_str();
     let r = match c.kind {

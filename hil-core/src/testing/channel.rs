@@ -7,8 +7,8 @@ use crate::{
 };
 
 /// Runs the query-channel conformance suite: asks `n` queries covering every
-/// response type, difficulty and distraction (with an oracle answer set, as a
-/// simulated environment would) and checks that every response's expert arm
+/// response type, difficulty and distraction (over a task-neutral space of six
+/// actions, with an oracle answer set, as a simulated environment would) and checks that every response's expert arm
 /// indexes the action space and that response times are finite and
 /// non-negative.
 ///
@@ -19,7 +19,10 @@ pub fn check_query_channel(
     n: usize,
 ) -> Result<ConformanceReport, ConformanceFailure> {
     let mut c = Checker::new(channel.name());
-    let actions = ActionSpace::feeding();
+    // A task-neutral space: channels must not depend on any one task's
+    // action names.
+    let actions = ActionSpace::new(["a", "b", "c", "d", "e", "f"])
+        .expect("six unique non-empty names form a valid action space");
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     channel.seed(5);
     for i in 0..n {
@@ -33,8 +36,8 @@ pub fn check_query_channel(
             t: i as u64 + 1,
             item: Item {
                 index: i,
-                label: "banana".into(),
-                description: Some("a banana slice near the plate edge".into()),
+                label: "object".into(),
+                description: Some("an object near the edge of the table".into()),
             },
             kind,
             actions: actions.clone(),

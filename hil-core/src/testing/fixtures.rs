@@ -7,9 +7,8 @@ use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
 use crate::{
-    ActionSpace, ArmId, Choice, Context, Decision, DecisionInput, Environment, Feedback, HilError,
-    Item, Outcome, Policy, Query, QueryChannel, QueryHistory, Response, Result, Timestep,
-    WorkloadModel,
+    ActionSpace, ArmId, CallOrder, Choice, Context, Decision, DecisionInput, Environment, Feedback,
+    HilError, Item, Outcome, Policy, QueryHistory, Result, Timestep, WorkloadModel,
 };
 
 /// An environment whose items have fixed per-arm success probabilities.
@@ -28,7 +27,7 @@ pub struct TableEnv {
     next: usize,
     played: usize,
     current: Option<Item>,
-    observed: bool,
+    order: CallOrder,
 }
 
 impl TableEnv {
@@ -58,7 +57,7 @@ impl TableEnv {
             next: 0,
             played: 0,
             current: None,
-            observed: false,
+            order: CallOrder::new("table_env"),
         })
     }
 
@@ -68,12 +67,15 @@ impl TableEnv {
         self
     }
 
-    fn probs(&self) -> Result<&[f64]> {
-        let item = self
-            .current
+    fn item_index(&self) -> Result<usize> {
+        self.current
             .as_ref()
-            .ok_or_else(|| HilError::state("table_env", "no current item: call next_item first"))?;
-        Ok(&self.items[item.index].1)
+            .map(|item| item.index)
+            .ok_or_else(|| HilError::state("table_env", "no current item: call next_item first"))
+    }
+
+    fn probs(&self) -> Result<&[f64]> {
+        Ok(&self.items[self.item_index()?].1)
     }
 }
 
@@ -92,13 +94,13 @@ impl Environment for TableEnv {
         self.next = 0;
         self.played = 0;
         self.current = None;
-        self.observed = false;
+        self.order.on_reset();
         Ok(())
     }
     fn next_item(&mut self) -> Result<Option<Item>> {
-        self.observed = false;
         if self.next >= self.items.len() {
             self.current = None;
+            self.order.on_next_item(false);
             return Ok(None);
         }
         let item = Item {
@@ -108,25 +110,20 @@ impl Environment for TableEnv {
         };
         self.next += 1;
         self.current = Some(item.clone());
+        self.order.on_next_item(true);
         Ok(Some(item))
     }
     fn observe(&mut self) -> Result<Context> {
-        let label = &self
-            .current
-            .as_ref()
-            .ok_or_else(|| HilError::state("table_env", "no current item: call next_item first"))?
-            .label;
+        self.order.on_observe()?;
+        let label = &self.items[self.item_index()?].0;
         let mut x: Vec<f64> = self.types.iter().map(|t| f64::from(t == label)).collect();
         x.push(self.rng.random_range(-0.1..0.1));
         x.push(self.rng.random_range(-0.1..0.1));
-        self.observed = true;
         Context::new(x)
     }
     fn execute(&mut self, arm: ArmId) -> Result<Outcome> {
         self.actions.check(arm)?;
-        if !self.observed {
-            return Err(HilError::state("table_env", "execute before observe"));
-        }
+        self.order.on_execute()?;
         let p = self.probs()?[arm.0];
         let success = match &self.script {
             Some(s) => *s.get(self.played).ok_or_else(|| {
@@ -226,29 +223,6 @@ impl Policy for ScriptedPolicy {
         self.next = s.next;
         self.feedback = s.feedback;
         Ok(())
-    }
-}
-
-/// A perfect simulated expert: answers every query with the environment's
-/// best action (as in the paper's simulations). Errors if the environment
-/// does not know its best action.
-#[derive(Debug, Clone, Default)]
-pub struct OracleChannel {
-    /// Number of queries answered.
-    pub asked: usize,
-}
-
-impl QueryChannel for OracleChannel {
-    fn name(&self) -> &str {
-        "oracle"
-    }
-    fn ask(&mut self, query: &Query) -> Result<Response> {
-        self.asked += 1;
-        let arm = query.oracle_best.ok_or_else(|| HilError::Channel {
-            channel: "oracle".into(),
-            why: "the environment does not know its best action".into(),
-        })?;
-        Ok(Response::action(arm))
     }
 }
 

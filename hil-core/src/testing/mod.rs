@@ -7,8 +7,9 @@
 //! was checked and what was skipped (e.g. checkpointing for a policy that
 //! does not support it), or the first [`ConformanceFailure`].
 //!
-//! [`fixtures`] has small, real implementations of every trait for tests of
-//! code that consumes the traits (session loop, logs, metrics), and
+//! [`fixtures`] has small, real implementations of the traits for tests of
+//! code that consumes them (session loop, logs, metrics; the channel to use
+//! is the real [`crate::channel::PerfectExpert`]), and
 //! [`strategies`] has proptest strategies (contexts, query histories,
 //! positive-definite matrices), and [`cdylib`] builds plugin libraries
 //! from tests.

@@ -1,0 +1,120 @@
+//! A simple counting workload model (`type = "demo_counting"`), for trying
+//! the channels and the interaction record without a fitted model.
+//!
+//! It is deliberately simple and is not one of the paper's models (those are
+//! in [`crate::models`]).
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use hil_core::config::WorkloadModelConfig;
+use hil_core::{BuildContext, HilError, QueryHistory, Result, Timestep, WorkloadModel};
+
+/// Config of the demo workload model, `type = "demo_counting"`:
+///
+/// ```toml
+/// [workload]
+/// type = "demo_counting"
+/// increment = 0.05   # each query in the window adds this
+/// window = 10        # timesteps a query keeps counting (H)
+/// ```
+///
+/// ```
+/// use hil_core::{QueryHistory, QueryKind, WorkloadModel};
+/// use hil_workload::demo_counting::DemoCounting;
+///
+/// let model = DemoCounting { increment: 0.1, window: 10 };
+/// let mut history = QueryHistory::new();
+/// history.push(4, QueryKind::default())?;
+/// assert!((model.predict(0.5, &history, 5)? - 0.6).abs() < 1e-12);
+/// # Ok::<(), hil_core::HilError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DemoCounting {
+    /// Workload added per query in the window, in [0, 1].
+    pub increment: f64,
+    /// Number of timesteps a query counts for (at least 1).
+    pub window: u64,
+}
+
+#[typetag::serde(name = "demo_counting")]
+impl WorkloadModelConfig for DemoCounting {
+    fn build(&self, _ctx: &BuildContext) -> Result<Arc<dyn WorkloadModel>> {
+        if !(0.0..=1.0).contains(&self.increment) {
+            return Err(HilError::invalid_parameter(
+                "increment",
+                self.increment,
+                "must be in [0, 1]",
+            ));
+        }
+        if self.window == 0 {
+            return Err(HilError::invalid_parameter(
+                "window",
+                0,
+                "must be at least 1",
+            ));
+        }
+        Ok(Arc::new(*self))
+    }
+}
+
+/// WL_t = clamp(WL_0 + increment · (queries in the last `window` steps), 0, 1).
+impl WorkloadModel for DemoCounting {
+    fn name(&self) -> &str {
+        "demo_counting"
+    }
+    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
+        let n = history.recent(t, self.window).count();
+        Ok((wl0 + self.increment * n as f64).clamp(0.0, 1.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hil_core::QueryKind;
+
+    #[test]
+    fn the_demo_workload_conforms() {
+        hil_core::testing::check_workload_model(&DemoCounting {
+            increment: 0.05,
+            window: 10,
+        })
+        .unwrap();
+    }
+
+    #[test]
+    fn queries_count_within_the_window_only() {
+        let m = DemoCounting {
+            increment: 0.1,
+            window: 3,
+        };
+        let mut h = QueryHistory::new();
+        h.push(1, QueryKind::default()).unwrap();
+        h.push(2, QueryKind::default()).unwrap();
+        assert!((m.predict(0.2, &h, 2).unwrap() - 0.4).abs() < 1e-12);
+        assert!((m.predict(0.2, &h, 10).unwrap() - 0.2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_parameters_are_rejected() {
+        let ctx = BuildContext::new(".", 0);
+        for bad in [
+            DemoCounting {
+                increment: 1.5,
+                window: 3,
+            },
+            DemoCounting {
+                increment: 0.1,
+                window: 0,
+            },
+        ] {
+            assert!(matches!(
+                bad.build(&ctx),
+                Err(HilError::InvalidParameter { .. })
+            ));
+        }
+    }
+}

@@ -268,6 +268,22 @@ impl Study {
                         )
                     })
             };
+            // A query variable, spelled as hil-core's `FromStr` spells it.
+            fn variable<T: std::str::FromStr<Err = HilError>>(
+                (v, f): (&str, String),
+                at: &dyn Fn(&str, String) -> HilError,
+            ) -> Result<Option<T>> {
+                if v.is_empty() {
+                    return Ok(None);
+                }
+                v.parse::<T>().map(Some).map_err(|e| match e {
+                    HilError::InvalidParameter { why, .. } => {
+                        at(&f, format!("unknown value `{v}`; {why}"))
+                    }
+                    other => at(&f, other.to_string()),
+                })
+            }
+            let at = |f: &str, why: String| data_err(path, line, f, why);
             let seconds = |name: &str, v: &str, f: &str| -> Result<f64> {
                 let x: f64 = v
                     .parse()
@@ -298,11 +314,10 @@ impl Study {
             let (t, tf) = req("query_time_s")?;
             let query_time_s = seconds("a time", t, &tf)?;
             req("distraction")?;
-            let distraction =
-                Distraction::ALL[enum_of("distraction", &["none", "easy", "hard"])?.unwrap_or(0)];
-            let difficulty = enum_of("difficulty", &["easy", "hard"])?.map(|i| Difficulty::ALL[i]);
-            let response = enum_of("response_type", &["mcq", "bounding_box", "open_ended"])?
-                .map(|i| ResponseType::ALL[i]);
+            let distraction: Distraction =
+                variable(cell("distraction"), &at)?.unwrap_or_default();
+            let difficulty: Option<Difficulty> = variable(cell("difficulty"), &at)?;
+            let response: Option<ResponseType> = variable(cell("response_type"), &at)?;
             let interval = enum_of("interval_min", &["1", "2"])?.map(|i| i as u8 + 1);
             let query = match (difficulty, response, interval) {
                 (Some(difficulty), Some(response), Some(interval_min)) => Some(PosedQuery {
@@ -499,8 +514,8 @@ impl Study {
         for r in &self.records {
             let (d, rt, iv) = match r.query {
                 Some(q) => (
-                    ["easy", "hard"][q.difficulty as usize],
-                    ["mcq", "bounding_box", "open_ended"][q.response as usize],
+                    q.difficulty.as_str(),
+                    q.response.as_str(),
                     q.interval_min.to_string(),
                 ),
                 None => ("", "", String::new()),
@@ -512,7 +527,7 @@ impl Study {
                 r.population.as_str(),
                 r.condition,
                 r.query_time_s,
-                ["none", "easy", "hard"][r.distraction as usize],
+                r.distraction.as_str(),
                 r.tlx.mental,
                 r.tlx.temporal,
                 r.tlx.performance,

@@ -1,10 +1,12 @@
-//! Dependency-free SVG figures of protocol runs: the LinUCB-QG rollout (WL_t,
-//! the gap G, the threshold w·WL_t and the query times) and the workload of
-//! several policies over one episode.
+//! hil's one SVG plotting module (dependency-free: a few hundred lines of
+//! SVG text are smaller than a plotting crate and its font stack): the
+//! LinUCB-QG rollout (WL_t, the gap G, the threshold w·WL_t and the query
+//! times), the workload of several policies over one episode, and a
+//! workload model's rollout over a query schedule.
 
 use std::fmt::Write as _;
 
-use hil_core::{Result, WorkloadModel};
+use hil_core::{Result, Timestep, WorkloadModel};
 
 use crate::testbed::RunRecord;
 
@@ -285,4 +287,44 @@ pub fn workload_comparison_svg(
     }
     out.push_str("</svg>\n");
     Ok(out)
+}
+
+/// One panel of WL_t for t = 0..=T (`wl[t]`), red circles at `queries`:
+/// a workload model rolled out over a query schedule (`hil workload rollout`).
+///
+/// ```
+/// let svg = hil_experiments::plot::workload_curve_svg("f", "synthetic", &[0.5, 0.6, 0.55], &[1]);
+/// assert!(svg.starts_with("<svg") && svg.matches("<circle").count() == 1);
+/// ```
+pub fn workload_curve_svg(title: &str, note: &str, wl: &[f64], queries: &[Timestep]) -> String {
+    let (lo, hi) = wl
+        .iter()
+        .fold((0.0f64, 1.0f64), |(a, b), y| (a.min(*y), b.max(*y)));
+    let p = Panel {
+        x0: 0.0,
+        x1: (wl.len().max(2) - 1) as f64,
+        y0: lo,
+        y1: hi,
+        top: TOP + 14.0,
+    };
+    let mut out = header(TOP + 14.0 + PANEL_H + 40.0);
+    let _ = writeln!(
+        out,
+        r##"<text x="{LEFT}" y="16" font-size="11" fill="#a00">{}</text>"##,
+        esc(note)
+    );
+    p.frame(&mut out, title, "WL_t");
+    let pts: Vec<(f64, f64)> = wl.iter().enumerate().map(|(t, y)| (t as f64, *y)).collect();
+    p.polyline(&mut out, &pts, "#1f5fbf", false);
+    for &t in queries {
+        let y = wl.get(t as usize).copied().unwrap_or(0.0);
+        let _ = writeln!(
+            out,
+            r##"<circle cx="{:.1}" cy="{:.1}" r="5" fill="none" stroke="red" stroke-width="2"/>"##,
+            p.px(t as f64),
+            p.py(y)
+        );
+    }
+    out.push_str("</svg>\n");
+    out
 }

@@ -297,7 +297,16 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 points.push((t, wl, !asked.is_empty()));
             }
             if let Some(path) = svg {
-                write(&path, &svg_plot(&m.name, wl0, &points))?;
+                let wl: Vec<f64> = points.iter().map(|p| p.1).collect();
+                let asked: Vec<Timestep> = points.iter().filter(|p| p.2).map(|p| p.0).collect();
+                let title = format!("WL_t of {} (WL_0 = {wl0}); Δt = 10 s", m.name);
+                let note = match (&m.provenance.data, &m.provenance.note) {
+                    (_, Some(note)) => note.clone(),
+                    (Some(data), None) => format!("fitted on {data}"),
+                    (None, None) => "provenance unknown".to_string(),
+                };
+                let svg = hil_experiments::plot::workload_curve_svg(&title, &note, &wl, &asked);
+                write(&path, &svg)?;
                 eprintln!("wrote {}", path.display());
             }
             Ok(())
@@ -368,44 +377,6 @@ fn parse_schedule(s: &str) -> Result<Vec<(Timestep, QueryKind)>> {
         out.push((t, k));
     }
     Ok(out)
-}
-
-/// A small line plot of WL_t with query markers.
-fn svg_plot(name: &str, wl0: f64, points: &[(Timestep, f64, bool)]) -> String {
-    let (w, h, m) = (640.0, 320.0, 40.0);
-    let tmax = points.last().map_or(1, |p| p.0.max(1)) as f64;
-    let x = |t: Timestep| m + (w - 2.0 * m) * t as f64 / tmax;
-    let y = |v: f64| h - m - (h - 2.0 * m) * v;
-    let path: Vec<String> = points
-        .iter()
-        .map(|&(t, v, _)| format!("{:.1},{:.1}", x(t), y(v)))
-        .collect();
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n\
-         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
-         <line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/>\n\
-         <line x1=\"{m}\" y1=\"{m}\" x2=\"{m}\" y2=\"{}\" stroke=\"black\"/>\n\
-         <text x=\"{m}\" y=\"20\">WL_t of {name} (WL_0 = {wl0}); Δt = 10 s; synthetic-data model</text>\n\
-         <text x=\"5\" y=\"{:.1}\">1</text><text x=\"5\" y=\"{:.1}\">0</text>\n\
-         <text x=\"{:.1}\" y=\"{}\">t = {tmax}</text>\n",
-        h - m,
-        w - m,
-        h - m,
-        h - m,
-        y(1.0) + 4.0,
-        y(0.0) + 4.0,
-        w - m - 30.0,
-        h - m + 16.0,
-    );
-    for &(t, _, q) in points.iter().filter(|p| p.2) {
-        let _ = q;
-        s.push_str(&format!("<line x1=\"{0:.1}\" y1=\"{m}\" x2=\"{0:.1}\" y2=\"{1}\" stroke=\"#c33\" stroke-dasharray=\"3,3\"/>\n", x(t), h - m));
-    }
-    s.push_str(&format!(
-        "<polyline fill=\"none\" stroke=\"#236\" stroke-width=\"2\" points=\"{}\"/>\n</svg>\n",
-        path.join(" ")
-    ));
-    s
 }
 
 #[cfg(test)]

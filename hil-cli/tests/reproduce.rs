@@ -208,8 +208,14 @@ type = "simulated_expert"
     let run: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let m = &run["episodes"][0];
     let run_dwl = m["delta_wl"].as_f64().unwrap();
-    assert!(run_dwl < -0.4, "f2_sim without queries is far below WL_0: {m}");
-    assert!((run_dwl - reproduce_dwl).abs() < 1e-12, "{run_dwl} vs {reproduce_dwl}");
+    assert!(
+        run_dwl < -0.4,
+        "f2_sim without queries is far below WL_0: {m}"
+    );
+    assert!(
+        (run_dwl - reproduce_dwl).abs() < 1e-12,
+        "{run_dwl} vs {reproduce_dwl}"
+    );
     // M_wt from the same definition: w·r − (1 − w)·ΔWL.
     let r = row["test"]["r_task_avg"]["mean"].as_f64().unwrap();
     let mwt = row["test"]["m_wt"]["mean"].as_f64().unwrap();

@@ -72,9 +72,8 @@ pub struct BuildContext {
 /// ```
 #[derive(Default)]
 pub struct BuildMemo {
-    values: std::sync::Mutex<
-        std::collections::HashMap<String, Arc<dyn std::any::Any + Send + Sync>>,
-    >,
+    values:
+        std::sync::Mutex<std::collections::HashMap<String, Arc<dyn std::any::Any + Send + Sync>>>,
 }
 
 impl std::fmt::Debug for BuildMemo {

@@ -8,8 +8,8 @@ use serde::Serialize;
 
 use crate::plot::{rollout_svg, workload_comparison_svg};
 use crate::report::tables_markdown;
-use crate::testbed::{NamedModel, Phase, RunRecord};
 use crate::results::ProtocolResults;
+use crate::testbed::{NamedModel, Phase, RunRecord};
 
 /// Where the time went.
 #[derive(Clone, Debug, Default, Serialize)]

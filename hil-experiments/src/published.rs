@@ -127,7 +127,10 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<PublishedRow>> {
         field: field.to_string(),
         why,
     };
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
     let (_, head) = lines
         .next()
         .ok_or_else(|| err(1, "header", "the file is empty".into()))?;
@@ -142,11 +145,7 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<PublishedRow>> {
                 .is_some_and(|base| columns.contains(&base))
             || columns.contains(&format!("{c}_std").as_str());
         if !known {
-            return Err(err(
-                1,
-                c,
-                "a figure column needs its `_std` partner".into(),
-            ));
+            return Err(err(1, c, "a figure column needs its `_std` partner".into()));
         }
     }
     let mut rows = Vec::new();

@@ -225,7 +225,11 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<
             }
             line
         };
-        let _ = writeln!(o, "{}", metric("r_task,avg", &|t| t.r_task_avg, "r_task_avg"));
+        let _ = writeln!(
+            o,
+            "{}",
+            metric("r_task,avg", &|t| t.r_task_avg, "r_task_avg")
+        );
         let _ = writeln!(o, "{}", metric("ΔWL", &|t| t.delta_wl, "delta_wl"));
         let _ = writeln!(o, "{}", metric("M_wt", &|t| t.m_wt, "m_wt"));
         let _ = writeln!(o, "{}", metric("f_q", &|t| t.f_q, "f_q"));

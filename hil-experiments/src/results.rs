@@ -219,7 +219,10 @@ fn select(
         if runs.is_empty() {
             return Err(HilError::state(
                 "protocol",
-                format!("no validation runs of `{}` {:?}", s.methods[i].label, cand.0),
+                format!(
+                    "no validation runs of `{}` {:?}",
+                    s.methods[i].label, cand.0
+                ),
             ));
         }
         let scored = score_all(&runs, &models[m])?;

@@ -507,7 +507,11 @@ pub fn perfect_expert() -> Box<dyn QueryChannel> {
 
 impl Protocol {
     /// The paper's protocol over `dataset` and `models`, with its perfect expert.
-    pub fn new(settings: ProtocolSettings, dataset: Arc<FoodDataset>, models: Vec<NamedModel>) -> Self {
+    pub fn new(
+        settings: ProtocolSettings,
+        dataset: Arc<FoodDataset>,
+        models: Vec<NamedModel>,
+    ) -> Self {
         Self {
             settings,
             dataset,
@@ -644,7 +648,9 @@ impl Protocol {
                 m.config(&point)?.build(&ctx).map_err(|e| {
                     HilError::invalid_parameter(
                         format!("methods.{}", m.label),
-                        point.as_ref().map_or("the policy".into(), |(n, v)| format!("{n} = {v}")),
+                        point
+                            .as_ref()
+                            .map_or("the policy".into(), |(n, v)| format!("{n} = {v}")),
                         e.to_string(),
                     )
                 })?;

@@ -34,7 +34,9 @@ fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
         ..ProtocolSettings::paper()
     };
     settings.methods[2].tune.insert("c".into(), vec![0.0, 2.0]);
-    settings.methods[3].tune.insert("w".into(), vec![0.5, 1.5, 3.0]);
+    settings.methods[3]
+        .tune
+        .insert("w".into(), vec![0.5, 1.5, 3.0]);
     settings.figures.model = "fast".into();
     settings.figures.w_task = 0.9;
     let models = vec![
@@ -122,7 +124,12 @@ fn protocol_runs_selects_on_validation_and_is_deterministic() {
         .collect();
     let rescored: f64 = decided
         .iter()
-        .map(|r| r.metrics.rescored(models[1].model.as_ref()).unwrap().delta_wl)
+        .map(|r| {
+            r.metrics
+                .rescored(models[1].model.as_ref())
+                .unwrap()
+                .delta_wl
+        })
         .sum::<f64>()
         / decided.len() as f64;
     assert!((rescored - c.test.delta_wl.mean).abs() < 1e-12);
@@ -212,9 +219,8 @@ fn plots_render_runs() {
         svg.matches("r=\"5\" fill=\"none\" stroke=\"red\"").count(),
         rec.metrics.queries.len()
     );
-    let svg =
-        hil_experiments::plot::workload_comparison_svg(&[("a", &rec), ("b", &rec)], m, "n")
-            .unwrap();
+    let svg = hil_experiments::plot::workload_comparison_svg(&[("a", &rec), ("b", &rec)], m, "n")
+        .unwrap();
     assert_eq!(svg.matches("<polyline").count(), 2);
 }
 

@@ -11,8 +11,8 @@
 //! every training set's equations are sums (or differences) of them. Designs
 //! for shorter histories are prefixes. Folds run on all cores.
 
+use rayon::prelude::*;
 use std::fmt::Write as _;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use hil_core::{HilError, Result};
 use rand::SeedableRng;
@@ -476,46 +476,33 @@ pub fn cross_validate(
     let tasks: Vec<(usize, usize)> = (0..datasets.len())
         .flat_map(|d| (0..opts.outer_folds).map(move |o| (d, o)))
         .collect();
-    let next = AtomicUsize::new(0);
     let threads = if opts.threads == 0 {
         std::thread::available_parallelism().map_or(1, |n| n.get())
     } else {
         opts.threads
     };
-    let results: Vec<Result<Vec<(usize, usize, FoldScores)>>> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads.min(tasks.len()))
-            .map(|_| {
-                s.spawn(|| -> Result<Vec<(usize, usize, FoldScores)>> {
-                    let mut out = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, Ordering::Relaxed);
-                        let Some(&(d, o)) = tasks.get(i) else { break };
-                        let (train, inner, test) =
-                            fold_layout(o, opts.outer_folds, opts.inner_folds);
-                        let p = &problems[d];
-                        let split = p.split(&train, &inner);
-                        let mut scores = Vec::with_capacity(candidates.len());
-                        for &c in candidates {
-                            let (spec, lambda) = p.fit(c, &split, &opts.lambdas)?;
-                            scores.push((p.test_mse(&test, &spec)?, lambda));
-                        }
-                        out.push((d, o, scores));
-                    }
-                    Ok(out)
-                })
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.min(tasks.len()).max(1))
+        .build()
+        .map_err(|e| HilError::state("model selection", e.to_string()))?;
+    // Results come back in task order, whatever the thread count.
+    let flat: Vec<(usize, usize, FoldScores)> = pool.install(|| {
+        tasks
+            .par_iter()
+            .map(|&(d, o)| -> Result<(usize, usize, FoldScores)> {
+                let (train, inner, test) = fold_layout(o, opts.outer_folds, opts.inner_folds);
+                let p = &problems[d];
+                let split = p.split(&train, &inner);
+                let mut scores = Vec::with_capacity(candidates.len());
+                for &c in candidates {
+                    let (spec, lambda) = p.fit(c, &split, &opts.lambdas)?;
+                    scores.push((p.test_mse(&test, &spec)?, lambda));
+                }
+                Ok((d, o, scores))
             })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("selection worker panicked"))
-            .collect()
-    });
+            .collect::<Result<_>>()
+    })?;
     let mut per: Vec<Vec<FoldScores>> = vec![vec![Vec::new(); candidates.len()]; datasets.len()];
-    let mut flat = Vec::new();
-    for r in results {
-        flat.extend(r?);
-    }
-    flat.sort_by_key(|(d, o, _)| (*d, *o));
     for (d, _, scores) in flat {
         for (c, s) in scores.into_iter().enumerate() {
             per[d][c].push(s);

@@ -314,8 +314,7 @@ impl Study {
             let (t, tf) = req("query_time_s")?;
             let query_time_s = seconds("a time", t, &tf)?;
             req("distraction")?;
-            let distraction: Distraction =
-                variable(cell("distraction"), &at)?.unwrap_or_default();
+            let distraction: Distraction = variable(cell("distraction"), &at)?.unwrap_or_default();
             let difficulty: Option<Difficulty> = variable(cell("difficulty"), &at)?;
             let response: Option<ResponseType> = variable(cell("response_type"), &at)?;
             let interval = enum_of("interval_min", &["1", "2"])?.map(|i| i as u8 + 1);

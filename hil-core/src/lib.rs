@@ -37,6 +37,7 @@ pub mod policy;
 pub mod query;
 pub mod record;
 pub mod session;
+pub mod textdata;
 pub mod time;
 pub mod workload;
 

@@ -27,6 +27,7 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
+use hil_core::textdata::TextRecords;
 use hil_core::{ActionSpace, ArmId, HilError, Result};
 
 use crate::rates::{BUNDLED_RATES_CSV, POOLED, PublishedRates};
@@ -100,20 +101,9 @@ struct Described {
 /// Parses a `<key>,description` file (`#` lines are comments). A description
 /// runs to the end of the line, so it may contain commas.
 fn parse_described(text: &str, path: &Path, key: &str) -> Result<Vec<Described>> {
-    let err = |line: usize, field: &str, why: String| HilError::Data {
-        path: path.to_path_buf(),
-        record: line,
-        field: field.to_string(),
-        why,
-    };
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = lines
-        .next()
-        .ok_or_else(|| err(1, "header", "the file is empty".into()))?;
+    let data = TextRecords::parse(text, path)?;
+    let err = |line: usize, field: &str, why: String| data.error(line, field, why);
+    let (hline, header) = data.header;
     let expected = format!("{key},description");
     if header.replace(' ', "") != expected {
         return Err(err(
@@ -123,7 +113,7 @@ fn parse_described(text: &str, path: &Path, key: &str) -> Result<Vec<Described>>
         ));
     }
     let mut rows: Vec<Described> = Vec::new();
-    for (line, l) in lines {
+    for &(line, l) in &data.records {
         let Some((name, description)) = l.split_once(',') else {
             return Err(err(
                 line,

@@ -16,7 +16,8 @@
 
 use std::path::Path;
 
-use hil_core::{HilError, Result};
+use hil_core::Result;
+use hil_core::textdata::TextRecords;
 
 /// The CSV compiled into the crate.
 pub const BUNDLED_RATES_CSV: &str = include_str!("../data/food_success_rates.csv");
@@ -58,20 +59,9 @@ impl PublishedRates {
     /// Parses a rates CSV (`food,setting,<action>...`; `#` lines are
     /// comments). Every food needs one row per setting and one `all` row.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let err = |line: usize, field: &str, why: String| HilError::Data {
-            path: path.to_path_buf(),
-            record: line,
-            field: field.to_string(),
-            why,
-        };
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(i, l)| (i + 1, l.trim()))
-            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-        let (hline, header) = lines
-            .next()
-            .ok_or_else(|| err(1, "header", "the file is empty".into()))?;
+        let data = TextRecords::parse(text, path)?;
+        let err = |line: usize, field: &str, why: String| data.error(line, field, why);
+        let (hline, header) = data.header;
         let cols: Vec<&str> = header.split(',').map(str::trim).collect();
         if cols.len() < 3 || cols[0] != "food" || cols[1] != "setting" {
             return Err(err(
@@ -83,7 +73,7 @@ impl PublishedRates {
         let actions: Vec<String> = cols[2..].iter().map(|s| s.to_string()).collect();
         let mut settings: Vec<String> = Vec::new();
         let mut rows: Vec<(usize, String, String, Vec<f64>)> = Vec::new();
-        for (line, l) in lines {
+        for &(line, l) in &data.records {
             let f: Vec<&str> = l.split(',').map(str::trim).collect();
             if f.len() != cols.len() {
                 return Err(err(
@@ -174,6 +164,7 @@ impl PublishedRates {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hil_core::HilError;
 
     #[test]
     fn bundled_table_is_complete_and_pooled_rows_are_setting_means() {

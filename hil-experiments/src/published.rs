@@ -11,13 +11,16 @@
 //! ```
 //! let p = hil_experiments::published::tables().unwrap();
 //! let row = p.by_w_task("f2_sim", 0.7, "LinUCB-QG").unwrap();
-//! assert_eq!(row.get("f_q").unwrap().0, 0.667);
+//! assert_eq!(row.get("f_q").unwrap(), (0.333, 0.094));
 //! ```
 
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
-use hil_core::{HilError, Result};
+use std::path::Path;
+
+use hil_core::Result;
+use hil_core::textdata::TextRecords;
 
 const BY_W_TASK: (&str, &str) = (
     "data/published/by_w_task.csv",
@@ -121,20 +124,9 @@ const KEY_COLUMNS: [&str; 4] = ["model", "method", "decide", "score"];
 
 /// Parses one published-table CSV; errors name the file, line and column.
 pub fn parse(file: &str, text: &str) -> Result<Vec<PublishedRow>> {
-    let err = |line: usize, field: &str, why: String| HilError::Data {
-        path: file.into(),
-        record: line,
-        field: field.to_string(),
-        why,
-    };
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty());
-    let (_, head) = lines
-        .next()
-        .ok_or_else(|| err(1, "header", "the file is empty".into()))?;
-    let columns: Vec<&str> = head.split(',').map(str::trim).collect();
+    let data = TextRecords::parse(text, Path::new(file))?;
+    let err = |line: usize, field: &str, why: String| data.error(line, field, why);
+    let columns = data.columns();
     if !columns.contains(&"w_task") {
         return Err(err(1, "w_task", "missing column".into()));
     }
@@ -149,8 +141,7 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<PublishedRow>> {
         }
     }
     let mut rows = Vec::new();
-    for (i, line) in lines {
-        let n = i + 1;
+    for &(n, line) in &data.records {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
         if cells.len() != columns.len() {
             return Err(err(
@@ -190,6 +181,7 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<PublishedRow>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hil_core::HilError;
 
     #[test]
     fn transcription_is_complete_and_consistent() {

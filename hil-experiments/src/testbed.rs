@@ -109,13 +109,27 @@ impl Method {
 
     /// The policy config at grid point `point`.
     pub fn config(&self, point: &GridPoint) -> Result<Box<dyn PolicyConfig>> {
-        let mut table = self.policy.clone();
-        if let Some((name, value)) = point {
-            table.insert(name.clone(), toml::Value::Float(*value));
-        }
-        policy_config(&table).map_err(|why| {
+        policy_config(&self.table(point)).map_err(|why| {
             HilError::invalid_parameter(format!("methods.{}.policy", self.label), "table", why)
         })
+    }
+
+    /// The policy table at grid point `point`.
+    pub fn table(&self, point: &GridPoint) -> toml::Table {
+        let mut table = self.policy.clone();
+        if let Some((name, value)) = point {
+            // Keep an integer parameter an integer (TOML tells 3 from 3.0).
+            let integer = matches!(table.get(name), Some(toml::Value::Integer(_)))
+                && value.fract() == 0.0
+                && value.abs() < 2f64.powi(53);
+            let v = if integer {
+                toml::Value::Integer(*value as i64)
+            } else {
+                toml::Value::Float(*value)
+            };
+            table.insert(name.clone(), v);
+        }
+        table
     }
 }
 
@@ -674,5 +688,25 @@ impl Protocol {
                 r
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_values_keep_the_parameter_type() {
+        let mut policy = toml::Table::new();
+        policy.insert("n".into(), toml::Value::Integer(3));
+        policy.insert("w".into(), toml::Value::Float(1.0));
+        let m = Method::new("m", policy);
+        let t = m.table(&Some(("n".into(), 2.0)));
+        assert_eq!(t["n"], toml::Value::Integer(2));
+        let t = m.table(&Some(("n".into(), 2.5)));
+        assert_eq!(t["n"], toml::Value::Float(2.5));
+        let t = m.table(&Some(("w".into(), 4.0)));
+        assert_eq!(t["w"], toml::Value::Float(4.0));
+        assert_eq!(m.table(&None), m.policy);
     }
 }

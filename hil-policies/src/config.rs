@@ -136,11 +136,7 @@ pub trait RuleConfig:
     /// Whether its decisions depend on its own seed.
     const STOCHASTIC: bool;
     /// Validated rule parameters, given the shared α and query kind.
-    fn params(
-        &self,
-        alpha: f64,
-        query_kind: QueryKind,
-    ) -> Result<<Self::Rule as QueryRule>::Params>;
+    fn params(&self, alpha: f64, query_kind: QueryKind) -> Result<Self::Rule>;
     /// A seed overriding the experiment seed.
     fn seed(&self) -> Option<u64> {
         None

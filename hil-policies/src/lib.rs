@@ -46,11 +46,10 @@ pub use estimator::{
     ArmEstimate, EstimatorOptions, LinearArms, Representation, RepresentationChoice,
 };
 pub use exp_decay::{
-    LinUcbExpDecay, LinUcbExpDecayConfig, LinUcbExpDecayFields, LinUcbExpDecayParams,
-    LinUcbExpDecayRule,
+    ExpDecayRng, LinUcbExpDecay, LinUcbExpDecayConfig, LinUcbExpDecayFields, LinUcbExpDecayParams,
 };
 pub use linucb::{LinUcb, LinUcbConfig, LinUcbFields, LinUcbParams};
-pub use policy::{LinearPolicy, QueryRule};
+pub use policy::{LinearPolicy, QueryRule, RuleContext};
 pub use qg::{LinUcbQg, LinUcbQgConfig, LinUcbQgFields, LinUcbQgParams, QueryGap, query_gap};
 
 /// Does nothing; calling it keeps this crate (and its typetag registrations)

@@ -15,40 +15,46 @@ use serde_json::Value;
 use crate::common;
 use crate::estimator::{ArmEstimate, LinearArms};
 
+/// What a rule sees when it decides (one struct, so that adding a field
+/// never breaks a rule).
+#[derive(Debug)]
+pub struct RuleContext<'a, 'b> {
+    /// Every arm's score at the decision's context, indexed by arm.
+    pub scores: &'a [ArmEstimate],
+    /// The LinUCB arm argmax θᵀx + α·b(x): what the policy acts with, and
+    /// the fallback of a query.
+    pub ucb_arm: ArmId,
+    /// The session's decision input (attempt, items seen, workload forecast).
+    pub input: &'a DecisionInput<'b>,
+    /// The decision's diagnostics, already holding the per-arm figures; the
+    /// rule may add to them and the policy attaches them to its decision.
+    pub diagnostics: &'a mut Diagnostics,
+}
+
 /// How a policy turns scored arms into a decision: act with the LinUCB
-/// arm, or ask. Implement it (and [`crate::RuleConfig`] for configs) to add
-/// a policy over the shared estimator.
-pub trait QueryRule: Clone + Debug + Send + 'static {
+/// arm, or ask. A rule *is* its validated hyperparameters (α included);
+/// randomness or counters it needs live in its [`QueryRule::State`].
+/// Implement it (and [`crate::RuleConfig`] for configs) to add a policy over
+/// the shared estimator.
+pub trait QueryRule: Copy + Debug + PartialEq + Send + Sync + 'static {
     /// The policy's name: in checkpoints, records and configs (`type`).
     const NAME: &'static str;
-    /// Validated hyperparameters (α included).
-    type Params: Copy + Debug + PartialEq;
+    /// The rule's mutable state (`()` for none); its `Default` is the state
+    /// before [`hil_core::Policy::seed`] is called.
+    type State: Clone + Debug + Default + Send;
 
-    /// The rule with these parameters (and any state at its initial value).
-    fn from_params(params: Self::Params) -> Self;
-    /// The parameters it was made with.
-    fn params(&self) -> Self::Params;
     /// The weight α ≥ 0 of the confidence bonus.
     fn alpha(&self) -> f64;
-    /// Decides at `input` given every arm's score (`scores`, indexed by
-    /// arm) and the LinUCB arm argmax θᵀx + α·b(x) (`ucb_arm`, also the
-    /// fallback of a query). May add to `diag`, which already holds the
-    /// per-arm figures; the policy attaches it to the returned decision.
-    fn decide(
-        &mut self,
-        scores: &[ArmEstimate],
-        ucb_arm: ArmId,
-        input: &DecisionInput<'_>,
-        diag: &mut Diagnostics,
-    ) -> Result<Decision>;
-    /// Reseeds the rule's randomness, if it has any.
-    fn seed(&mut self, _seed: u64) {}
-    /// The rule's own state for checkpoints (`null` if it has none).
-    fn save_state(&self) -> Value {
+    /// Decides from `ctx`.
+    fn decide(&self, state: &mut Self::State, ctx: RuleContext<'_, '_>) -> Result<Decision>;
+    /// Reseeds the state's randomness, if it has any.
+    fn seed(_state: &mut Self::State, _seed: u64) {}
+    /// The state for checkpoints (`null` if there is none).
+    fn save_state(_state: &Self::State) -> Value {
         Value::Null
     }
-    /// Restores [`QueryRule::save_state`]; on error the rule is unchanged.
-    fn restore_state(&mut self, _state: Value) -> Result<()> {
+    /// Restores [`QueryRule::save_state`]; on error nothing changes.
+    fn restore_state(_state: &mut Self::State, _saved: Value) -> Result<()> {
         Ok(())
     }
 }
@@ -62,21 +68,24 @@ pub trait QueryRule: Clone + Debug + Send + 'static {
 #[derive(Clone, Debug)]
 pub struct LinearPolicy<R: QueryRule> {
     rule: R,
+    state: R::State,
     arms: LinearArms,
 }
 
 impl<R: QueryRule> LinearPolicy<R> {
-    /// The policy over `arms` (possibly pretrained).
-    pub fn new(params: R::Params, arms: LinearArms) -> Self {
+    /// The policy with rule (hyperparameters) `rule` over `arms` (possibly
+    /// pretrained).
+    pub fn new(rule: R, arms: LinearArms) -> Self {
         Self {
-            rule: R::from_params(params),
+            rule,
+            state: R::State::default(),
             arms,
         }
     }
 
     /// The parameters.
-    pub fn params(&self) -> R::Params {
-        self.rule.params()
+    pub fn params(&self) -> R {
+        self.rule
     }
 
     /// The estimator.
@@ -96,7 +105,7 @@ impl<R: QueryRule> Policy for LinearPolicy<R> {
         self.arms.dim()
     }
     fn seed(&mut self, seed: u64) {
-        self.rule.seed(seed);
+        R::seed(&mut self.state, seed);
     }
     fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
         let alpha = self.rule.alpha();
@@ -114,7 +123,13 @@ impl<R: QueryRule> Policy for LinearPolicy<R> {
             ..Default::default()
         };
         let ucb_arm = ArmId(common::argmax(&scores, |s| s.ucb(alpha)));
-        let d = self.rule.decide(&scores, ucb_arm, input, &mut diag)?;
+        let ctx = RuleContext {
+            scores: &scores,
+            ucb_arm,
+            input,
+            diagnostics: &mut diag,
+        };
+        let d = self.rule.decide(&mut self.state, ctx)?;
         Ok(d.with_diagnostics(diag))
     }
     /// Learns from the executed arm and its reward (the expert's arm after
@@ -123,12 +138,16 @@ impl<R: QueryRule> Policy for LinearPolicy<R> {
         self.arms.update(fb.context, fb.arm, fb.reward)
     }
     fn save(&self) -> Result<Value> {
-        Ok(common::save(R::NAME, &self.arms, self.rule.save_state()))
+        Ok(common::save(
+            R::NAME,
+            &self.arms,
+            R::save_state(&self.state),
+        ))
     }
     fn restore(&mut self, state: Value) -> Result<()> {
         let (arms, extra) = common::restore(self, state)?;
         // The rule first: if its state is bad, nothing has changed.
-        self.rule.restore_state(extra)?;
+        R::restore_state(&mut self.state, extra)?;
         self.arms = arms;
         Ok(())
     }

@@ -5,11 +5,10 @@ mod config;
 
 pub use config::{AlwaysQueryConfig, AlwaysQueryFields};
 
-use hil_core::{ArmId, Decision, DecisionInput, Diagnostics, QueryKind, Result};
+use hil_core::{Decision, QueryKind, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::estimator::ArmEstimate;
-use crate::policy::{LinearPolicy, QueryRule};
+use crate::policy::{LinearPolicy, QueryRule, RuleContext};
 
 /// AlwaysQuery hyperparameters; also its rule, which has no state.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -51,23 +50,11 @@ pub type AlwaysQuery = LinearPolicy<AlwaysQueryParams>;
 
 impl QueryRule for AlwaysQueryParams {
     const NAME: &'static str = "always_query";
-    type Params = Self;
-    fn from_params(params: Self) -> Self {
-        params
-    }
-    fn params(&self) -> Self {
-        *self
-    }
+    type State = ();
     fn alpha(&self) -> f64 {
         self.alpha
     }
-    fn decide(
-        &mut self,
-        _scores: &[ArmEstimate],
-        ucb_arm: ArmId,
-        _input: &DecisionInput<'_>,
-        _diag: &mut Diagnostics,
-    ) -> Result<Decision> {
-        Ok(Decision::query(self.query_kind, ucb_arm))
+    fn decide(&self, _: &mut (), ctx: RuleContext<'_, '_>) -> Result<Decision> {
+        Ok(Decision::query(self.query_kind, ctx.ucb_arm))
     }
 }

@@ -3,7 +3,7 @@
 use hil_core::{QueryKind, Result};
 use serde::{Deserialize, Serialize};
 
-use super::{LinUcbExpDecayParams, LinUcbExpDecayRule};
+use super::LinUcbExpDecayParams;
 use crate::config::{LinearPolicyConfig, RuleConfig};
 
 /// Config for [`crate::LinUcbExpDecay`]. The policy is seeded from the
@@ -30,7 +30,7 @@ pub struct LinUcbExpDecayFields {
 }
 
 impl RuleConfig for LinUcbExpDecayFields {
-    type Rule = LinUcbExpDecayRule;
+    type Rule = LinUcbExpDecayParams;
     const FIELDS: &'static [&'static str] = &["c", "seed"];
     const ASKS: bool = true;
     const USES_WORKLOAD_FORECAST: bool = false;

@@ -6,14 +6,13 @@ mod rng_state;
 
 pub use config::{LinUcbExpDecayConfig, LinUcbExpDecayFields};
 
-use hil_core::{ArmId, Decision, DecisionInput, Diagnostics, QueryKind, Result};
+use hil_core::{Decision, QueryKind, Result};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use crate::estimator::ArmEstimate;
-use crate::policy::{LinearPolicy, QueryRule};
+use crate::policy::{LinearPolicy, QueryRule, RuleContext};
 
 /// LinUCB-ExpDecay hyperparameters.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -66,60 +65,48 @@ impl LinUcbExpDecayParams {
 /// input.attempt = 1; // later attempts never query
 /// assert!(matches!(p.decide(&input).unwrap().choice, Choice::Act { .. }));
 /// ```
-pub type LinUcbExpDecay = LinearPolicy<LinUcbExpDecayRule>;
+pub type LinUcbExpDecay = LinearPolicy<LinUcbExpDecayParams>;
 
-/// The rule of [`LinUcbExpDecay`]: its parameters and its RNG, seeded
-/// with 0 until [`hil_core::Policy::seed`] is called.
+/// LinUCB-ExpDecay's state: its RNG, seeded with 0 until
+/// [`hil_core::Policy::seed`] is called.
 #[derive(Clone, Debug)]
-pub struct LinUcbExpDecayRule {
-    params: LinUcbExpDecayParams,
-    rng: ChaCha8Rng,
+pub struct ExpDecayRng(ChaCha8Rng);
+
+impl Default for ExpDecayRng {
+    fn default() -> Self {
+        Self(ChaCha8Rng::seed_from_u64(0))
+    }
 }
 
-impl QueryRule for LinUcbExpDecayRule {
+impl QueryRule for LinUcbExpDecayParams {
     const NAME: &'static str = "linucb_exp_decay";
-    type Params = LinUcbExpDecayParams;
-    fn from_params(params: LinUcbExpDecayParams) -> Self {
-        Self {
-            params,
-            rng: ChaCha8Rng::seed_from_u64(0),
-        }
-    }
-    fn params(&self) -> LinUcbExpDecayParams {
-        self.params
-    }
+    type State = ExpDecayRng;
     fn alpha(&self) -> f64 {
-        self.params.alpha
+        self.alpha
     }
-    fn decide(
-        &mut self,
-        _scores: &[ArmEstimate],
-        ucb_arm: ArmId,
-        input: &DecisionInput<'_>,
-        diag: &mut Diagnostics,
-    ) -> Result<Decision> {
-        if input.attempt != 0 {
-            return Ok(Decision::act(ucb_arm));
+    fn decide(&self, rng: &mut ExpDecayRng, ctx: RuleContext<'_, '_>) -> Result<Decision> {
+        if ctx.input.attempt != 0 {
+            return Ok(Decision::act(ctx.ucb_arm));
         }
-        let p = self.params.query_probability(input.items_seen);
-        diag.query_probability = Some(p);
+        let p = self.query_probability(ctx.input.items_seen);
+        ctx.diagnostics.query_probability = Some(p);
         // One draw per item's first timestep, whatever p is, so the random
         // stream does not depend on the decay rate.
-        let u: f64 = self.rng.random();
+        let u: f64 = rng.0.random();
         Ok(if u < p {
-            Decision::query(self.params.query_kind, ucb_arm)
+            Decision::query(self.query_kind, ctx.ucb_arm)
         } else {
-            Decision::act(ucb_arm)
+            Decision::act(ctx.ucb_arm)
         })
     }
-    fn seed(&mut self, seed: u64) {
-        self.rng = ChaCha8Rng::seed_from_u64(seed);
+    fn seed(rng: &mut ExpDecayRng, seed: u64) {
+        rng.0 = ChaCha8Rng::seed_from_u64(seed);
     }
-    fn save_state(&self) -> Value {
-        rng_state::save(&self.rng)
+    fn save_state(rng: &ExpDecayRng) -> Value {
+        rng_state::save(&rng.0)
     }
-    fn restore_state(&mut self, state: Value) -> Result<()> {
-        self.rng = rng_state::restore(state)?;
+    fn restore_state(rng: &mut ExpDecayRng, saved: Value) -> Result<()> {
+        rng.0 = rng_state::restore(saved)?;
         Ok(())
     }
 }

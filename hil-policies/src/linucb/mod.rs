@@ -4,11 +4,10 @@ mod config;
 
 pub use config::{LinUcbConfig, LinUcbFields};
 
-use hil_core::{ArmId, Decision, DecisionInput, Diagnostics, Result};
+use hil_core::{Decision, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::estimator::ArmEstimate;
-use crate::policy::{LinearPolicy, QueryRule};
+use crate::policy::{LinearPolicy, QueryRule, RuleContext};
 
 /// LinUCB hyperparameters (λ lives in the estimator); also its rule, which
 /// has no state.
@@ -48,23 +47,11 @@ pub type LinUcb = LinearPolicy<LinUcbParams>;
 
 impl QueryRule for LinUcbParams {
     const NAME: &'static str = "linucb";
-    type Params = Self;
-    fn from_params(params: Self) -> Self {
-        params
-    }
-    fn params(&self) -> Self {
-        *self
-    }
+    type State = ();
     fn alpha(&self) -> f64 {
         self.alpha
     }
-    fn decide(
-        &mut self,
-        _scores: &[ArmEstimate],
-        ucb_arm: ArmId,
-        _input: &DecisionInput<'_>,
-        _diag: &mut Diagnostics,
-    ) -> Result<Decision> {
-        Ok(Decision::act(ucb_arm))
+    fn decide(&self, _: &mut (), ctx: RuleContext<'_, '_>) -> Result<Decision> {
+        Ok(Decision::act(ctx.ucb_arm))
     }
 }

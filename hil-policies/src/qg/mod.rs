@@ -7,11 +7,10 @@ mod gap;
 pub use config::{LinUcbQgConfig, LinUcbQgFields};
 pub use gap::{QueryGap, query_gap};
 
-use hil_core::{ArmId, Decision, DecisionInput, Diagnostics, QueryKind, Result};
+use hil_core::{Decision, QueryKind, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::estimator::ArmEstimate;
-use crate::policy::{LinearPolicy, QueryRule};
+use crate::policy::{LinearPolicy, QueryRule, RuleContext};
 
 /// LinUCB-QG hyperparameters; also its rule, which has no state.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -66,35 +65,23 @@ pub type LinUcbQg = LinearPolicy<LinUcbQgParams>;
 
 impl QueryRule for LinUcbQgParams {
     const NAME: &'static str = "linucb_qg";
-    type Params = Self;
-    fn from_params(params: Self) -> Self {
-        params
-    }
-    fn params(&self) -> Self {
-        *self
-    }
+    type State = ();
     fn alpha(&self) -> f64 {
         self.alpha
     }
-    fn decide(
-        &mut self,
-        scores: &[ArmEstimate],
-        ucb_arm: ArmId,
-        input: &DecisionInput<'_>,
-        diag: &mut Diagnostics,
-    ) -> Result<Decision> {
-        let Some(g) = query_gap(scores, self.alpha) else {
-            return Ok(Decision::act(ucb_arm));
+    fn decide(&self, _: &mut (), ctx: RuleContext<'_, '_>) -> Result<Decision> {
+        let Some(g) = query_gap(ctx.scores, self.alpha) else {
+            return Ok(Decision::act(ctx.ucb_arm));
         };
-        let wl = input.workload.if_queried(self.query_kind)?;
+        let wl = ctx.input.workload.if_queried(self.query_kind)?;
         let threshold = self.w * wl;
-        diag.gap = Some(g.gap);
-        diag.threshold = Some(threshold);
-        diag.workload_forecast = Some(wl);
+        ctx.diagnostics.gap = Some(g.gap);
+        ctx.diagnostics.threshold = Some(threshold);
+        ctx.diagnostics.workload_forecast = Some(wl);
         Ok(if g.gap > threshold {
-            Decision::query(self.query_kind, ucb_arm)
+            Decision::query(self.query_kind, ctx.ucb_arm)
         } else {
-            Decision::act(ucb_arm)
+            Decision::act(ctx.ucb_arm)
         })
     }
 }

@@ -233,12 +233,10 @@ impl<'a> Registrar<'a> {
     where
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn Policy>> + Send + Sync + 'static,
     {
-        let (lib, n) = (self.library.clone(), name.to_string());
-        let f: PolicyFactory = Arc::new(move |p, ctx| {
-            let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
-            Ok(Box::new(GuardedPolicy::new(inner, lib.clone(), &n)?) as Box<dyn Policy>)
-        });
-        self.host.add(name, description, Factory::Policy(f));
+        let guard = |inner, lib, n: &str| {
+            Ok(Box::new(GuardedPolicy::new(inner, lib, n)?) as Box<dyn Policy>)
+        };
+        self.add(name, description, factory, guard, Factory::Policy);
     }
 
     /// Registers an environment factory under `name`.
@@ -246,12 +244,10 @@ impl<'a> Registrar<'a> {
     where
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn Environment>> + Send + Sync + 'static,
     {
-        let (lib, n) = (self.library.clone(), name.to_string());
-        let f: EnvironmentFactory = Arc::new(move |p, ctx| {
-            let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
-            Ok(Box::new(GuardedEnvironment::new(inner, lib.clone(), &n)?) as Box<dyn Environment>)
-        });
-        self.host.add(name, description, Factory::Environment(f));
+        let guard = |inner, lib, n: &str| {
+            Ok(Box::new(GuardedEnvironment::new(inner, lib, n)?) as Box<dyn Environment>)
+        };
+        self.add(name, description, factory, guard, Factory::Environment);
     }
 
     /// Registers a workload-model factory under `name`.
@@ -259,12 +255,10 @@ impl<'a> Registrar<'a> {
     where
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn WorkloadModel>> + Send + Sync + 'static,
     {
-        let (lib, n) = (self.library.clone(), name.to_string());
-        let f: WorkloadModelFactory = Arc::new(move |p, ctx| {
-            let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
-            Ok(Box::new(GuardedWorkload::new(inner, lib.clone(), &n)?) as Box<dyn WorkloadModel>)
-        });
-        self.host.add(name, description, Factory::WorkloadModel(f));
+        let guard = |inner, lib, n: &str| {
+            Ok(Box::new(GuardedWorkload::new(inner, lib, n)?) as Box<dyn WorkloadModel>)
+        };
+        self.add(name, description, factory, guard, Factory::WorkloadModel);
     }
 
     /// Registers a query-channel factory under `name`.
@@ -272,12 +266,30 @@ impl<'a> Registrar<'a> {
     where
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn QueryChannel>> + Send + Sync + 'static,
     {
+        let guard = |inner, lib, n: &str| {
+            Ok(Box::new(GuardedChannel::new(inner, lib, n)?) as Box<dyn QueryChannel>)
+        };
+        self.add(name, description, factory, guard, Factory::QueryChannel);
+    }
+
+    /// The one registration path of every kind: the plugin's factory runs
+    /// under the panic guard, and what it builds is wrapped by `guard` (so
+    /// every later call into the object is guarded too) before the host
+    /// gets it.
+    fn add<T: ?Sized + 'static>(
+        &mut self,
+        name: &str,
+        description: &str,
+        factory: impl Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync + 'static,
+        guard: fn(Box<T>, PathBuf, &str) -> Result<Box<T>>,
+        kind: fn(Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync>) -> Factory,
+    ) {
         let (lib, n) = (self.library.clone(), name.to_string());
-        let f: QueryChannelFactory = Arc::new(move |p, ctx| {
+        let f = Arc::new(move |p: &Params, ctx: &BuildContext| {
             let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
-            Ok(Box::new(GuardedChannel::new(inner, lib.clone(), &n)?) as Box<dyn QueryChannel>)
+            guard(inner, lib.clone(), &n)
         });
-        self.host.add(name, description, Factory::QueryChannel(f));
+        self.host.add(name, description, kind(f));
     }
 }
 

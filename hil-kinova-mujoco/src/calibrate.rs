@@ -28,6 +28,8 @@
 //! ```
 
 use std::collections::HashMap;
+
+use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -189,82 +191,68 @@ pub fn calibrate_with(
         })
         .collect();
     let total = jobs.len();
-    let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<AttemptRecord>>> = Mutex::new(vec![None; total]);
-    let timing = Mutex::new((Duration::ZERO, Duration::ZERO));
-    let worker = || -> Result<()> {
-        let mut envs: HashMap<(FoodKind, Setting), KinovaFeedingEnv> = HashMap::new();
-        let out = (|| -> Result<()> {
-            loop {
-                let j = next.fetch_add(1, Ordering::Relaxed);
-                let Some(&(food, a, t)) = jobs.get(j) else {
-                    return Ok(());
-                };
-                let setting = opts.settings[t % opts.settings.len()];
-                let env = match envs.entry((food, setting)) {
-                    std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-                    std::collections::hash_map::Entry::Vacant(e) => {
-                        e.insert(KinovaFeedingEnv::new(KinovaFeedingConfig {
-                            plate: vec![food.name().to_string()],
-                            settings: vec![setting.name().to_string()],
-                            ..KinovaFeedingConfig::default()
-                        })?)
-                    }
-                };
-                let seed = trial_seed(opts.seed, food, a, t);
-                env.reset(seed)?;
-                env.next_item()?;
-                env.observe()?;
-                env.execute(ArmId(a))?;
-                let report = env.last_attempt().cloned().ok_or_else(|| {
-                    HilError::state("kinova calibrate", "an attempt left no report")
-                })?;
-                lock(&results)[j] = Some(AttemptRecord {
-                    food,
-                    setting,
-                    trial: t,
-                    seed,
-                    report,
-                });
-                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .map_err(|e| HilError::state("kinova calibrate", e.to_string()))?;
+    // One set of simulators per worker thread, kept across its jobs
+    // (building a MuJoCo scene costs far more than an attempt).
+    type Scenes = HashMap<(FoodKind, Setting), KinovaFeedingEnv>;
+    let scenes: Vec<Mutex<Scenes>> = (0..opts.threads).map(|_| Mutex::default()).collect();
+    let attempt = |&(food, a, t): &(FoodKind, usize, usize)| -> Result<AttemptRecord> {
+        let worker = rayon::current_thread_index().unwrap_or(0) % scenes.len();
+        let mut envs = lock(&scenes[worker]);
+        let setting = opts.settings[t % opts.settings.len()];
+        let env = match envs.entry((food, setting)) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(KinovaFeedingEnv::new(KinovaFeedingConfig {
+                    plate: vec![food.name().to_string()],
+                    settings: vec![setting.name().to_string()],
+                    ..KinovaFeedingConfig::default()
+                })?)
             }
-        })();
-        let mut tm = lock(&timing);
-        for env in envs.values() {
-            let t = env.simulator().timing();
-            tm.0 += t.in_step;
-            tm.1 += t.total;
-        }
-        if out.is_err() {
-            // Stop the other workers early.
-            next.store(total, Ordering::Relaxed);
-        }
-        out
+        };
+        let seed = trial_seed(opts.seed, food, a, t);
+        env.reset(seed)?;
+        env.next_item()?;
+        env.observe()?;
+        env.execute(ArmId(a))?;
+        let report = env
+            .last_attempt()
+            .cloned()
+            .ok_or_else(|| HilError::state("kinova calibrate", "an attempt left no report"))?;
+        progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+        Ok(AttemptRecord {
+            food,
+            setting,
+            trial: t,
+            seed,
+            report,
+        })
     };
-    std::thread::scope(|s| {
-        let handles: Vec<_> = (0..opts.threads).map(|_| s.spawn(worker)).collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join().unwrap_or_else(|_| {
-                    Err(HilError::state("kinova calibrate", "a worker panicked"))
-                })
-            })
-            .collect::<Result<Vec<()>>>()
-    })?;
+    // Records come back in job order; the first error stops the run.
+    let records: Vec<AttemptRecord> =
+        pool.install(|| jobs.par_iter().map(attempt).collect::<Result<_>>())?;
+    let mut timing = (Duration::ZERO, Duration::ZERO);
+    for envs in scenes {
+        for env in envs
+            .into_inner()
+            .unwrap_or_else(|e| e.into_inner())
+            .values()
+        {
+            let t = env.simulator().timing();
+            timing.0 += t.in_step;
+            timing.1 += t.total;
+        }
+    }
     let wall = start.elapsed().as_secs_f64();
-    let records: Vec<AttemptRecord> = results
-        .into_inner()
-        .unwrap_or_else(|e| e.into_inner())
-        .into_iter()
-        .collect::<Option<_>>()
-        .ok_or_else(|| HilError::state("kinova calibrate", "an attempt did not run"))?;
     for r in &records {
         log(r);
     }
     let rows = tabulate(opts, &records);
-    let (in_step, busy) = timing.into_inner().unwrap_or_else(|e| e.into_inner());
+    let (in_step, busy) = timing;
     let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len().max(1) as f64;
     Ok(CalibrationReport {
         mean_abs_error: mean(

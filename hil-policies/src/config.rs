@@ -31,9 +31,6 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use crate::estimator::{EstimatorOptions, LinearArms};
 use crate::policy::{LinearPolicy, QueryRule};
 
-/// The config types of the built-in policies, as registered.
-pub const POLICY_TYPES: [&str; 4] = ["linucb", "always_query", "linucb_exp_decay", "linucb_qg"];
-
 /// The keys of [`EstimatorConfig`] (kept in step with it by a test).
 const ESTIMATOR_KEYS: [&str; 4] = ["alpha", "lambda", "pretrain", "estimator"];
 
@@ -135,6 +132,9 @@ pub trait RuleConfig:
     const USES_WORKLOAD_FORECAST: bool;
     /// Whether its decisions depend on its own seed.
     const STOCHASTIC: bool;
+    /// Values of its own required fields for a quick run when the user
+    /// gives none (`hil bench policy --policy TYPE`).
+    const EXAMPLE: &'static [(&'static str, f64)] = &[];
     /// Validated rule parameters, given the shared α and query kind.
     fn params(&self, alpha: f64, query_kind: QueryKind) -> Result<Self::Rule>;
     /// A seed overriding the experiment seed.
@@ -255,7 +255,8 @@ impl<F: RuleConfig> Serialize for LinearPolicyConfig<F> {
 /// Registers `LinearPolicyConfig<$fields>` as the policy config `type =
 /// $name`: adding a built-in policy is one folder plus one of these lines.
 macro_rules! register {
-    ($fields:ty, $name:literal) => {
+    ($($fields:ty => $name:literal),+ $(,)?) => {
+        $(
         #[typetag::serde(name = $name)]
         impl hil_core::config::PolicyConfig for $crate::config::LinearPolicyConfig<$fields> {
             fn build(
@@ -271,13 +272,31 @@ macro_rules! register {
                 <$fields as $crate::config::RuleConfig>::STOCHASTIC
             }
         }
+        )+
+
+        /// The config types of the built-in policies, as registered.
+        pub const POLICY_TYPES: &[&str] = &[$($name),+];
+
+        /// Example values of `ty`'s own required fields
+        /// ([`RuleConfig::EXAMPLE`]); `None` if `ty` is not a built-in type.
+        pub fn example_fields(ty: &str) -> Option<&'static [(&'static str, f64)]> {
+            $(
+            if ty == $name {
+                return Some(<$fields as $crate::config::RuleConfig>::EXAMPLE);
+            }
+            )+
+            None
+        }
     };
 }
 
-register!(crate::linucb::LinUcbFields, "linucb");
-register!(crate::always_query::AlwaysQueryFields, "always_query");
-register!(crate::exp_decay::LinUcbExpDecayFields, "linucb_exp_decay");
-register!(crate::qg::LinUcbQgFields, "linucb_qg");
+// The one list of the built-in policies: adding one is its folder plus a line here.
+register! {
+    crate::linucb::LinUcbFields => "linucb",
+    crate::always_query::AlwaysQueryFields => "always_query",
+    crate::exp_decay::LinUcbExpDecayFields => "linucb_exp_decay",
+    crate::qg::LinUcbQgFields => "linucb_qg",
+}
 
 #[cfg(test)]
 mod tests {

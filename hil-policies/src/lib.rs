@@ -27,7 +27,7 @@
 //! [`EstimatorConfig`] (and `query_kind`, for those that ask), see
 //! [`LinearPolicyConfig`]. A new policy over the estimator is a folder with
 //! its rule ([`QueryRule`]), parameters and config fields
-//! ([`RuleConfig`]), plus one `register!` line in `config.rs`.
+//! ([`RuleConfig`]), plus one line in the `register!` list in `config.rs`.
 
 mod always_query;
 mod common;
@@ -41,7 +41,7 @@ mod policy;
 mod qg;
 
 pub use always_query::{AlwaysQuery, AlwaysQueryConfig, AlwaysQueryFields, AlwaysQueryParams};
-pub use config::{EstimatorConfig, LinearPolicyConfig, POLICY_TYPES, RuleConfig};
+pub use config::{EstimatorConfig, LinearPolicyConfig, POLICY_TYPES, RuleConfig, example_fields};
 pub use estimator::{
     ArmEstimate, EstimatorOptions, LinearArms, Representation, RepresentationChoice,
 };

@@ -28,7 +28,7 @@ fn minimal(ty: &str) -> String {
 
 #[test]
 fn facts_come_from_the_config() {
-    for ty in POLICY_TYPES {
+    for &ty in POLICY_TYPES {
         let cfg = parse(&minimal(ty)).unwrap_or_else(|e| panic!("{ty}: {e}"));
         assert_eq!(cfg.uses_workload_forecast(), ty == "linucb_qg", "{ty}");
         assert_eq!(cfg.is_stochastic(), ty == "linucb_exp_decay", "{ty}");
@@ -37,7 +37,7 @@ fn facts_come_from_the_config() {
 
 #[test]
 fn unknown_fields_are_rejected_and_named() {
-    for ty in POLICY_TYPES {
+    for &ty in POLICY_TYPES {
         // A misspelt shared key and a misspelt key of no policy.
         for bad in ["lamda", "estimater", "wx"] {
             let e = parse(&format!("{}{bad} = 1.0\n", minimal(ty))).unwrap_err();

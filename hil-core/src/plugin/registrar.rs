@@ -138,17 +138,15 @@ impl Params {
 }
 
 /// Builds a policy from parameters and the experiment's build context.
-pub type PolicyFactory =
-    Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<dyn Policy>> + Send + Sync>;
+pub type PolicyFactory = FactoryOf<dyn Policy>;
 /// Builds an environment.
-pub type EnvironmentFactory =
-    Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<dyn Environment>> + Send + Sync>;
+pub type EnvironmentFactory = FactoryOf<dyn Environment>;
 /// Builds a workload model.
-pub type WorkloadModelFactory =
-    Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<dyn WorkloadModel>> + Send + Sync>;
+pub type WorkloadModelFactory = FactoryOf<dyn WorkloadModel>;
 /// Builds a query channel.
-pub type QueryChannelFactory =
-    Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<dyn QueryChannel>> + Send + Sync>;
+pub type QueryChannelFactory = FactoryOf<dyn QueryChannel>;
+/// Builds a component of type `T` from its parameters.
+pub type FactoryOf<T> = Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync>;
 
 /// A factory of any kind.
 #[derive(Clone)]
@@ -282,7 +280,7 @@ impl<'a> Registrar<'a> {
         description: &str,
         factory: impl Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync + 'static,
         guard: fn(Box<T>, PathBuf, &str) -> Result<Box<T>>,
-        kind: fn(Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync>) -> Factory,
+        kind: fn(FactoryOf<T>) -> Factory,
     ) {
         let (lib, n) = (self.library.clone(), name.to_string());
         let f = Arc::new(move |p: &Params, ctx: &BuildContext| {

@@ -35,6 +35,7 @@ impl RuleConfig for LinUcbExpDecayFields {
     const ASKS: bool = true;
     const USES_WORKLOAD_FORECAST: bool = false;
     const STOCHASTIC: bool = true;
+    const EXAMPLE: &'static [(&'static str, f64)] = &[("c", 0.1)];
     fn params(&self, alpha: f64, query_kind: QueryKind) -> Result<LinUcbExpDecayParams> {
         LinUcbExpDecayParams::new(alpha, self.c, query_kind)
     }

@@ -32,6 +32,7 @@ impl RuleConfig for LinUcbQgFields {
     const ASKS: bool = true;
     const USES_WORKLOAD_FORECAST: bool = true;
     const STOCHASTIC: bool = false;
+    const EXAMPLE: &'static [(&'static str, f64)] = &[("w", 0.2)];
     fn params(&self, alpha: f64, query_kind: QueryKind) -> Result<LinUcbQgParams> {
         LinUcbQgParams::new(alpha, self.w, query_kind)
     }

@@ -34,10 +34,8 @@ fn builtin_defaults(ty: &str) -> Vec<(&'static str, toml::Value)> {
         ("alpha", toml::Value::Float(0.5)),
         ("pretrain", toml::Value::Boolean(true)),
     ];
-    match ty {
-        "linucb_qg" => d.push(("w", toml::Value::Float(0.2))),
-        "linucb_exp_decay" => d.push(("c", toml::Value::Float(0.1))),
-        _ => {}
+    for &(key, value) in hil_policies::example_fields(ty).unwrap_or_default() {
+        d.push((key, toml::Value::Float(value)));
     }
     d
 }

@@ -87,6 +87,26 @@ fn reproduce_rejects_a_bad_split() {
     std::fs::remove_dir_all(&root).unwrap();
 }
 
+/// Runs `hil reproduce --settings` on `ds` into `root/out` and returns
+/// `results.json` with the command's output.
+fn reproduce_with(root: &Path, ds: &str, settings: &str) -> (serde_json::Value, String) {
+    let path = root.join("s.toml");
+    std::fs::write(&path, settings).unwrap();
+    let out_dir = root.join("out");
+    let out = hil(&[
+        "reproduce",
+        "--dataset",
+        ds,
+        "--settings",
+        path.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let json = std::fs::read_to_string(out_dir.join("results.json")).unwrap();
+    (serde_json::from_str(&json).unwrap(), text(&out))
+}
+
 /// A small generated dataset (d = 224) in `root/ds`.
 fn small_dataset(root: &Path) -> String {
     let ds = root.join("ds");
@@ -146,30 +166,14 @@ fn hil_run_and_hil_reproduce_score_an_episode_alike() {
     let _ = std::fs::remove_dir_all(&root);
     std::fs::create_dir_all(&root).unwrap();
     let ds = small_dataset(&root);
-    let settings = root.join("s.toml");
-    std::fs::write(
-        &settings,
-        small_settings(
+    let (res, _) = reproduce_with(
+        &root,
+        &ds,
+        &small_settings(
             "[[methods]]\nlabel = \"LinUCB\"\npolicy = { type = \"linucb\", alpha = 0.5, pretrain = true }",
             "rollout = \"LinUCB\"\nworkload = [\"LinUCB\"]",
         ),
-    )
-    .unwrap();
-    let out_dir = root.join("out");
-    let out = hil(&[
-        "reproduce",
-        "--quiet",
-        "--dataset",
-        &ds,
-        "--settings",
-        settings.to_str().unwrap(),
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", text(&out));
-    let res: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap())
-            .unwrap();
+    );
     let row = res["rows"]
         .as_array()
         .unwrap()
@@ -252,22 +256,7 @@ tune = {{ v = [0.1, 1.0] }}"#,
         "{plugins}\n{}",
         small_settings(methods, "rollout = \"Thompson\"\nworkload = [\"Thompson\"]")
     );
-    let settings = root.join("s.toml");
-    std::fs::write(&settings, text_settings).unwrap();
-    let out_dir = root.join("out");
-    let out = hil(&[
-        "reproduce",
-        "--dataset",
-        &ds,
-        "--settings",
-        settings.to_str().unwrap(),
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", text(&out));
-    let res: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap())
-            .unwrap();
+    let (res, output) = reproduce_with(&root, &ds, &text_settings);
     let rows: Vec<&serde_json::Value> = res["rows"]
         .as_array()
         .unwrap()
@@ -279,6 +268,6 @@ tune = {{ v = [0.1, 1.0] }}"#,
         assert_eq!(r["selected"]["name"], "v", "{r}");
         assert!(r["test"]["n_runs"].as_u64().unwrap() >= 1);
     }
-    assert!(text(&out).contains("Thompson"));
+    assert!(output.contains("Thompson"));
     std::fs::remove_dir_all(&root).unwrap();
 }

@@ -139,6 +139,23 @@ impl Panel {
     }
 }
 
+/// A figure of `height` with `note` (say the data is synthetic) above its
+/// first panel, which starts at `TOP + 14`.
+fn figure(height: f64, note: &str) -> String {
+    let mut out = header(height);
+    let _ = writeln!(
+        out,
+        r##"<text x="{LEFT}" y="16" font-size="11" fill="#a00">{}</text>"##,
+        esc(note)
+    );
+    out
+}
+
+/// The y range of `ys`, widened to hold [0, 1].
+fn y_range(ys: impl Iterator<Item = f64>) -> (f64, f64) {
+    ys.fold((0.0f64, 1.0f64), |(a, b), y| (a.min(y), b.max(y)))
+}
+
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -194,7 +211,7 @@ pub fn rollout_svg(
         .copied()
         .chain(gaps.iter().map(|p| p.1))
         .chain(thr.iter().map(|p| p.1));
-    let (lo, hi) = ys.fold((0.0f64, 1.0f64), |(a, b), y| (a.min(y), b.max(y)));
+    let (lo, hi) = y_range(ys);
     let p = Panel {
         x0: 0.0,
         x1: run.metrics.t_final.max(1) as f64,
@@ -202,12 +219,7 @@ pub fn rollout_svg(
         y1: hi,
         top: TOP + 14.0,
     };
-    let mut out = header(TOP + 14.0 + PANEL_H + 70.0);
-    let _ = writeln!(
-        out,
-        r##"<text x="{LEFT}" y="16" font-size="11" fill="#a00">{}</text>"##,
-        esc(note)
-    );
+    let mut out = figure(TOP + 14.0 + PANEL_H + 70.0, note);
     p.frame(&mut out, title, "value");
     p.item_starts(&mut out, run);
     let wl_pts: Vec<(f64, f64)> = wl.iter().enumerate().map(|(t, y)| (t as f64, *y)).collect();
@@ -254,17 +266,9 @@ pub fn workload_comparison_svg(
     for (_, r) in runs {
         curves.push(r.workload_curve(model)?);
     }
-    let (lo, hi) = curves
-        .iter()
-        .flatten()
-        .fold((0.0f64, 1.0f64), |(a, b), y| (a.min(*y), b.max(*y)));
+    let (lo, hi) = y_range(curves.iter().flatten().copied());
     let h = TOP + 14.0 + runs.len() as f64 * (PANEL_H + GAP) + 20.0;
-    let mut out = header(h);
-    let _ = writeln!(
-        out,
-        r##"<text x="{LEFT}" y="16" font-size="11" fill="#a00">{}</text>"##,
-        esc(note)
-    );
+    let mut out = figure(h, note);
     for (k, ((label, run), wl)) in runs.iter().zip(&curves).enumerate() {
         let p = Panel {
             x0: 0.0,
@@ -297,9 +301,7 @@ pub fn workload_comparison_svg(
 /// assert!(svg.starts_with("<svg") && svg.matches("<circle").count() == 1);
 /// ```
 pub fn workload_curve_svg(title: &str, note: &str, wl: &[f64], queries: &[Timestep]) -> String {
-    let (lo, hi) = wl
-        .iter()
-        .fold((0.0f64, 1.0f64), |(a, b), y| (a.min(*y), b.max(*y)));
+    let (lo, hi) = y_range(wl.iter().copied());
     let p = Panel {
         x0: 0.0,
         x1: (wl.len().max(2) - 1) as f64,
@@ -307,12 +309,7 @@ pub fn workload_curve_svg(title: &str, note: &str, wl: &[f64], queries: &[Timest
         y1: hi,
         top: TOP + 14.0,
     };
-    let mut out = header(TOP + 14.0 + PANEL_H + 40.0);
-    let _ = writeln!(
-        out,
-        r##"<text x="{LEFT}" y="16" font-size="11" fill="#a00">{}</text>"##,
-        esc(note)
-    );
+    let mut out = figure(TOP + 14.0 + PANEL_H + 40.0, note);
     p.frame(&mut out, title, "WL_t");
     let pts: Vec<(f64, f64)> = wl.iter().enumerate().map(|(t, y)| (t as f64, *y)).collect();
     p.polyline(&mut out, &pts, "#1f5fbf", false);

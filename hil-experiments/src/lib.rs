@@ -5,6 +5,8 @@
 //! user-study protocol, aggregation with uncertainty, tables and figures, and
 //! the paper's published tables as data.
 //!
+//! - [`method`]: a method of either protocol (a labelled policy config,
+//!   built-in or plugin, with an optional tuned hyperparameter);
 //! - [`testbed`]: the paper's simulated-testbed protocol (methods as policy
 //!   configs, runs in parallel, hyperparameters chosen on validation, the
 //!   cross-data experiment);
@@ -18,6 +20,7 @@
 //! published figures**: they are not the paper's results, and every table and
 //! figure says so.
 
+pub mod method;
 pub mod output;
 pub mod plot;
 pub mod published;
@@ -26,5 +29,6 @@ pub mod results;
 pub mod testbed;
 pub mod user_study;
 
-pub use testbed::{Method, NamedModel, Protocol, ProtocolSettings};
+pub use method::Method;
+pub use testbed::{NamedModel, Protocol, ProtocolSettings};
 pub use user_study::{UserStudy, UserStudyConfig, UserStudyResult};

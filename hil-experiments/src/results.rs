@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 
 use hil_core::EpisodeMetrics;
 
-use crate::testbed::{GridPoint, NamedModel, Phase, ProtocolSettings, RunRecord};
+use crate::method::GridPoint;
+use crate::testbed::{NamedModel, Phase, ProtocolSettings, RunRecord};
 
 /// Mean and (population) standard deviation over runs.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

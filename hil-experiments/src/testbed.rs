@@ -31,12 +31,11 @@
 //! tune = { w = [0.25, 0.5, 1.0, 2.0] }   # at most one tuned hyperparameter
 //! ```
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use hil_core::config::{BuildContext, PolicyConfig};
+use hil_core::config::BuildContext;
 use hil_core::session::{ComponentSeeds, splitmix};
 use hil_core::{
     EpisodeMetrics, HilError, QueryChannel, Result, Session, SessionSettings, StepDecision,
@@ -45,93 +44,9 @@ use hil_core::{
 use hil_envs::env::{PretrainReward, pretraining_data};
 use hil_envs::{DatasetReplayEnv, FoodDataset, FoodSplit};
 use rayon::prelude::*;
-use serde::{Deserialize, Deserializer, Serialize};
 
-/// A method of the protocol: a policy config (any registered or plugin
-/// type), the label it is reported under, and at most one hyperparameter
-/// tuned over a grid.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Method {
-    /// The name tables print (e.g. `LinUCB-QG`); unique in a protocol.
-    pub label: String,
-    /// The policy table, as in an experiment file (`type = "..."` and the
-    /// type's parameters). Checked to build a policy config when parsed.
-    #[serde(deserialize_with = "policy_table")]
-    pub policy: toml::Table,
-    /// The tuned hyperparameter and its grid, e.g. `{ w = [0.5, 4.0] }`;
-    /// chosen on validation per (workload model, w_task). Empty: untuned.
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
-    pub tune: BTreeMap<String, Vec<f64>>,
-}
-
-/// Deserialises a policy table and checks that it names a policy config
-/// (built-in or from a loaded plugin) with valid fields.
-fn policy_table<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<toml::Table, D::Error> {
-    use serde::de::Error as _;
-    let table = toml::Table::deserialize(d)?;
-    policy_config(&table).map_err(D::Error::custom)?;
-    Ok(table)
-}
-
-/// The policy config a table describes.
-fn policy_config(table: &toml::Table) -> std::result::Result<Box<dyn PolicyConfig>, String> {
-    hil_core::plugin::component::<_, dyn PolicyConfig>(toml::Value::Table(table.clone()))
-        .map_err(|e: toml::de::Error| e.message().trim().to_string())
-}
-
-/// One point of a method's grid.
-pub type GridPoint = Option<(String, f64)>;
-
-impl Method {
-    /// A method from a policy table literal (built-in types must be linked).
-    pub fn new(label: &str, policy: toml::Table) -> Self {
-        Self {
-            label: label.into(),
-            policy,
-            tune: BTreeMap::new(),
-        }
-    }
-
-    /// The same method with `name` tuned over `values`.
-    pub fn tuned(mut self, name: &str, values: &[f64]) -> Self {
-        self.tune = BTreeMap::from([(name.to_string(), values.to_vec())]);
-        self
-    }
-
-    /// The grid points: `None` for an untuned method, else one per value.
-    pub fn grid(&self) -> Vec<GridPoint> {
-        match self.tune.iter().next() {
-            None => vec![None],
-            Some((name, values)) => values.iter().map(|v| Some((name.clone(), *v))).collect(),
-        }
-    }
-
-    /// The policy config at grid point `point`.
-    pub fn config(&self, point: &GridPoint) -> Result<Box<dyn PolicyConfig>> {
-        policy_config(&self.table(point)).map_err(|why| {
-            HilError::invalid_parameter(format!("methods.{}.policy", self.label), "table", why)
-        })
-    }
-
-    /// The policy table at grid point `point`.
-    pub fn table(&self, point: &GridPoint) -> toml::Table {
-        let mut table = self.policy.clone();
-        if let Some((name, value)) = point {
-            // Keep an integer parameter an integer (TOML tells 3 from 3.0).
-            let integer = matches!(table.get(name), Some(toml::Value::Integer(_)))
-                && value.fract() == 0.0
-                && value.abs() < 2f64.powi(53);
-            let v = if integer {
-                toml::Value::Integer(*value as i64)
-            } else {
-                toml::Value::Float(*value)
-            };
-            table.insert(name.clone(), v);
-        }
-        table
-    }
-}
+use crate::method::{GridPoint, Method, paper_policy};
+use serde::{Deserialize, Serialize};
 
 /// A cross-data setting: a method deciding with one model, scored with another.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -191,20 +106,6 @@ pub struct ProtocolSettings {
     pub cross_w_task: f64,
     /// What the figures show.
     pub figures: FigureSettings,
-}
-
-/// The paper's policy table for `ty`: α = 0.5 (the paper does not state
-/// it), λ = 1, pretrained on the pretraining foods.
-fn paper_policy(ty: &str, extra: &[(&str, f64)]) -> toml::Table {
-    let mut t = toml::Table::new();
-    t.insert("type".into(), toml::Value::String(ty.into()));
-    t.insert("alpha".into(), toml::Value::Float(0.5));
-    t.insert("lambda".into(), toml::Value::Float(1.0));
-    t.insert("pretrain".into(), toml::Value::Boolean(true));
-    for (k, v) in extra {
-        t.insert((*k).into(), toml::Value::Float(*v));
-    }
-    t
 }
 
 impl ProtocolSettings {
@@ -688,25 +589,5 @@ impl Protocol {
                 r
             })
             .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn grid_values_keep_the_parameter_type() {
-        let mut policy = toml::Table::new();
-        policy.insert("n".into(), toml::Value::Integer(3));
-        policy.insert("w".into(), toml::Value::Float(1.0));
-        let m = Method::new("m", policy);
-        let t = m.table(&Some(("n".into(), 2.0)));
-        assert_eq!(t["n"], toml::Value::Integer(2));
-        let t = m.table(&Some(("n".into(), 2.5)));
-        assert_eq!(t["n"], toml::Value::Float(2.5));
-        let t = m.table(&Some(("w".into(), 4.0)));
-        assert_eq!(t["w"], toml::Value::Float(4.0));
-        assert_eq!(m.table(&None), m.policy);
     }
 }

@@ -88,6 +88,14 @@ alpha = "high"
 }
 
 #[test]
+fn a_tuned_method_is_refused_by_name() {
+    let text = "[[methods]]\nlabel = \"QG\"\npolicy = { type = \"linucb_qg\", alpha = 0.5, w = 1.0 }\ntune = { w = [1.0, 2.0] }\n";
+    let err = parse(text).unwrap_err();
+    assert_eq!(err.field.as_deref(), Some("methods.tune"), "{err}");
+    assert_eq!(err.line, 4, "{err}");
+}
+
+#[test]
 fn unknown_policy_type_is_located() {
     let text = "[[methods]]\nlabel = \"X\"\npolicy = { type = \"linucbb\", alpha = 0.5 }\n";
     let err = parse(text).unwrap_err();

@@ -5,10 +5,12 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use hil_core::config::{
-    BuildContext, ConfigError, EnvironmentConfig, PolicyConfig, QueryChannelConfig,
-    WorkloadModelConfig, load_plugins, parse_toml,
+    BuildContext, ConfigError, EnvironmentConfig, QueryChannelConfig, WorkloadModelConfig,
+    load_plugins, parse_toml,
 };
 use hil_core::{HilError, Result, SessionSettings};
+
+use crate::method::{Method, paper_policy};
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -74,36 +76,13 @@ pub struct UserStudyConfig {
     pub channel: Box<dyn QueryChannelConfig>,
     /// The methods compared, in the order of the first repetition.
     #[serde(default = "paper_methods")]
-    pub methods: Vec<MethodConfig>,
-}
-
-/// One method of the study: a label for the tables and a policy.
-#[derive(Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MethodConfig {
-    /// The method's name in results (unique within a study).
-    pub label: String,
-    /// The policy; it keeps learning from one of its plates to the next.
-    #[serde(deserialize_with = "hil_core::plugin::component")]
-    pub policy: Box<dyn PolicyConfig>,
-}
-
-impl MethodConfig {
-    /// A method named `label` deciding with `policy`.
-    pub fn new(label: impl Into<String>, policy: Box<dyn PolicyConfig>) -> Self {
-        Self {
-            label: label.into(),
-            policy,
-        }
-    }
+    pub methods: Vec<Method>,
 }
 
 /// The study's attempts per item (N_att), as in the paper's user study.
 pub const PAPER_N_ATT: u32 = 3;
 /// Initial workload WL_0 of every plate.
 const PAPER_WL0: f64 = 0.5;
-/// Confidence weight α of every method.
-const PAPER_ALPHA: f64 = 0.5;
 /// LinUCB-QG's workload weight w.
 const PAPER_W: f64 = 0.3;
 /// Simulated pretraining attempts per (food, action) in the MuJoCo scene:
@@ -138,35 +117,11 @@ fn paper_channel() -> Box<dyn QueryChannelConfig> {
     Box::new(hil_channels::SimulatedExpertConfig::default())
 }
 
-/// The paper's parameters of one policy, read through the policy's own
-/// config type so that everything the paper leaves unsaid (λ, estimator,
-/// query kind) keeps that type's default.
-fn paper_policy<T: PolicyConfig + serde::de::DeserializeOwned + 'static>(
-    extra: &[(&str, f64)],
-) -> Box<dyn PolicyConfig> {
-    let mut t = toml::Table::new();
-    t.insert("alpha".into(), PAPER_ALPHA.into());
-    t.insert("pretrain".into(), true.into());
-    for (k, v) in extra {
-        t.insert((*k).into(), (*v).into());
-    }
-    let cfg: T = toml::Value::Table(t)
-        .try_into()
-        .expect("the paper's policy parameters are a valid config of the policy's type");
-    Box::new(cfg)
-}
-
-fn paper_methods() -> Vec<MethodConfig> {
+fn paper_methods() -> Vec<Method> {
     vec![
-        MethodConfig::new("LinUCB", paper_policy::<hil_policies::LinUcbConfig>(&[])),
-        MethodConfig::new(
-            "AlwaysQuery",
-            paper_policy::<hil_policies::AlwaysQueryConfig>(&[]),
-        ),
-        MethodConfig::new(
-            "LinUCB-QG",
-            paper_policy::<hil_policies::LinUcbQgConfig>(&[("w", PAPER_W)]),
-        ),
+        Method::new("LinUCB", paper_policy("linucb", &[])),
+        Method::new("AlwaysQuery", paper_policy("always_query", &[])),
+        Method::new("LinUCB-QG", paper_policy("linucb_qg", &[("w", PAPER_W)])),
     ]
 }
 
@@ -263,6 +218,13 @@ impl UserStudyConfig {
             if !seen.insert(m.label.as_str()) {
                 let msg = format!("`{}` names two methods; labels must be unique", m.label);
                 return Err(located_label(text, path, i, &msg));
+            }
+            if !m.tune.is_empty() {
+                return Err(at(
+                    &["methods", "tune"],
+                    "a user study does not tune hyperparameters (it has no validation phase); \
+                     give the policy's values in `policy`",
+                ));
             }
         }
         Ok(())

@@ -24,13 +24,13 @@
 //! type = "simulated_expert"
 //! [[methods]]
 //! label = "LinUCB"
-//! policy = { type = "linucb", alpha = 0.5, pretrain = true }
+//! policy = { type = "linucb", alpha = 0.5, lambda = 1.0, pretrain = true }
 //! [[methods]]
 //! label = "AlwaysQuery"
-//! policy = { type = "always_query", alpha = 0.5, pretrain = true }
+//! policy = { type = "always_query", alpha = 0.5, lambda = 1.0, pretrain = true }
 //! [[methods]]
 //! label = "LinUCB-QG"
-//! policy = { type = "linucb_qg", alpha = 0.5, w = 0.3, pretrain = true }
+//! policy = { type = "linucb_qg", alpha = 0.5, lambda = 1.0, w = 0.3, pretrain = true }
 //! ```
 //!
 //! Run it with [`UserStudyConfig::run`], or, to observe or wrap the
@@ -40,7 +40,7 @@
 mod config;
 mod run;
 
-pub use config::{MethodConfig, PAPER_N_ATT, UserStudyConfig};
+pub use config::{PAPER_N_ATT, UserStudyConfig};
 pub use run::{
     Episode, MeanSem, MethodSummary, Plate, PlateResult, Protocol, UserStudy, UserStudyResult,
     mean_sem, method_order,

@@ -210,7 +210,7 @@ impl UserStudyConfig {
             .methods
             .iter()
             .map(|m| {
-                m.policy.build(&ctx).map_err(|e| {
+                m.config(&None)?.build(&ctx).map_err(|e| {
                     hil_core::HilError::invalid_input(
                         format!("method `{}`", m.label),
                         e.to_string(),

@@ -493,6 +493,21 @@ impl Protocol {
         Ok(jobs)
     }
 
+    /// The episode label and the component seeds of run `key`: environment
+    /// seeds crossed with policy seeds, so that every method meets the same
+    /// items, images and outcomes (common random numbers).
+    pub fn seeds(&self, key: &RunKey) -> (u64, ComponentSeeds) {
+        let s = &self.settings;
+        let env_seed = s.env_seed(key.seed);
+        let label = splitmix(env_seed, key.policy_seed as u64);
+        let seeds = ComponentSeeds {
+            environment: env_seed,
+            policy: s.policy_seed(key.policy_seed),
+            channel: ComponentSeeds::derive(label).channel,
+        };
+        (label, seeds)
+    }
+
     /// Runs one episode.
     pub fn run_one(&self, key: &RunKey, ctx: &BuildContext) -> Result<RunRecord> {
         let s = &self.settings;
@@ -509,13 +524,7 @@ impl Protocol {
         // Methods that ignore the forecast are scored with the first model;
         // the tables rescore every run under each model anyway.
         let model = self.models[key.decide_model.unwrap_or(0)].model.clone();
-        let env_seed = s.env_seed(key.seed);
-        let label = splitmix(env_seed, key.policy_seed as u64);
-        let seeds = ComponentSeeds {
-            environment: env_seed,
-            policy: s.policy_seed(key.policy_seed),
-            channel: ComponentSeeds::derive(label).channel,
-        };
+        let (label, seeds) = self.seeds(key);
         let mut session = Session {
             settings: s.session.clone(),
             environment: &mut env,

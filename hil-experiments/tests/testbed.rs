@@ -242,3 +242,88 @@ fn paper_protocol_config_file_matches_the_built_in_settings() {
     let e = hil_core::config::parse_toml::<ProtocolSettings>(&bad, &path).unwrap_err();
     assert!(e.message.contains("omega"), "{e}");
 }
+
+#[test]
+fn a_testbed_episode_and_an_experiment_file_episode_score_alike() {
+    // The same episode (same components, same seeds) through the protocol
+    // and through an experiment file, as `hil run` builds it: hil-core's one
+    // scoring definition gives the same ΔWL and M_wt (and every other figure).
+    hil_policies::link();
+    hil_workload::link();
+    hil_channels::link();
+    let dataset = hil_envs::bundled_dataset().unwrap();
+    let f2 = hil_workload::bundled::load("f2_sim").unwrap();
+    let mut settings = ProtocolSettings::paper();
+    settings.methods.truncate(4);
+    settings.methods[3].tune.clear(); // LinUCB-QG at its table's w = 1
+    let p = Protocol::new(
+        settings.clone(),
+        dataset,
+        vec![NamedModel {
+            name: "f2_sim".into(),
+            model: f2,
+        }],
+    );
+    let key = RunKey {
+        phase: Phase::Test,
+        method: 3,
+        point: None,
+        decide_model: Some(0),
+        seed: 1,
+        policy_seed: 0,
+    };
+    let rec = p.run_one(&key, &p.build_context().unwrap()).unwrap();
+    assert!(rec.metrics.n_q > 0, "a querying episode: {:?}", rec.metrics);
+
+    let quote = |v: &[String]| {
+        v.iter()
+            .map(|f| format!("\"{f}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let text = format!(
+        r#"
+seed = {seed}
+[session]
+n_att = 10
+wl0 = 0.5
+[environment]
+type = "food_replay"
+foods = [{test}]
+pretrain_foods = [{pretrain}]
+items_per_episode = 5
+[policy]
+type = "linucb_qg"
+alpha = 0.5
+lambda = 1.0
+pretrain = true
+w = 1.0
+[workload]
+type = "bundled"
+name = "f2_sim"
+[channel]
+type = "simulated_expert"
+"#,
+        seed = settings.seed,
+        test = quote(&settings.split.test),
+        pretrain = quote(&settings.split.pretrain),
+    );
+    let path = std::path::Path::new("episode.toml");
+    let cfg = hil_core::ExperimentConfig::parse(&text, path).unwrap();
+    let mut exp = cfg.build(std::path::Path::new(".")).unwrap();
+    let (label, seeds) = p.seeds(&key);
+    let report = hil_core::Session {
+        settings: exp.settings.clone(),
+        environment: exp.environment.as_mut(),
+        policy: exp.policy.as_mut(),
+        channel: exp.channel.as_mut(),
+        workload: exp.workload.clone(),
+        forecast: None,
+    }
+    .run_episode_with_seeds(label, seeds, &mut [])
+    .unwrap();
+    let m = &report.metrics;
+    assert_eq!(m.delta_wl, rec.metrics.delta_wl);
+    assert_eq!(m.m_wt(0.7), rec.metrics.m_wt(0.7));
+    assert_eq!(m, &rec.metrics);
+}

@@ -388,22 +388,24 @@ impl hil_core::WorkloadModel for Decaying {
 fn workload_is_the_models_wl_t_at_every_step_and_scored_at_the_last() {
     // The paper's WL_T = f(WL_0, Q_T) at the last step: a model that decays
     // between queries decays in the trace and in ΔWL, not only at queries.
-    let mut env = TableEnv::new(actions(), vec![("pear", vec![0.0, 0.0, 0.0])]).unwrap();
-    let mut policy = ScriptedPolicy::new(3, 3, vec![query(2), act(1), act(1), act(1)]);
-    let mut channel = Decliner(0);
-    let r = Session {
-        settings: SessionSettings {
-            n_att: 4,
-            ..Default::default()
-        },
-        environment: &mut env,
-        policy: &mut policy,
-        channel: &mut channel,
-        workload: Arc::new(Decaying),
-        forecast: None,
-    }
-    .run_episode(0, &mut [])
-    .unwrap();
+    let run = |script: Vec<Choice>, n_att: u32| {
+        let mut env = TableEnv::new(actions(), vec![("pear", vec![0.0, 0.0, 0.0])]).unwrap();
+        let mut policy = ScriptedPolicy::new(3, 3, script);
+        Session {
+            settings: SessionSettings {
+                n_att,
+                ..Default::default()
+            },
+            environment: &mut env,
+            policy: &mut policy,
+            channel: &mut Decliner(0),
+            workload: Arc::new(Decaying),
+            forecast: None,
+        }
+        .run_episode(0, &mut [])
+        .unwrap()
+    };
+    let r = run(vec![query(2), act(1), act(1), act(1)], 4);
     let wl: Vec<f64> = r.events.iter().map(|e| e.step.wl_t).collect();
     let expect = [0.7, 0.7, 0.4, 0.4];
     assert!(
@@ -422,20 +424,7 @@ fn workload_is_the_models_wl_t_at_every_step_and_scored_at_the_last() {
         (m.r_task_avg, m.f_q, m.n_q)
     );
     // A policy that never asks is scored at f(WL_0, ∅), not at WL_0.
-    let mut policy = ScriptedPolicy::new(3, 3, vec![act(1)]);
-    let r = Session {
-        settings: SessionSettings {
-            n_att: 2,
-            ..Default::default()
-        },
-        environment: &mut env,
-        policy: &mut policy,
-        channel: &mut channel,
-        workload: Arc::new(Decaying),
-        forecast: None,
-    }
-    .run_episode(0, &mut [])
-    .unwrap();
+    let r = run(vec![act(1)], 2);
     assert!((r.metrics.delta_wl + 0.1).abs() < 1e-12, "{:?}", r.metrics);
 }
 

@@ -64,10 +64,11 @@ pub struct CrossSetting {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FigureSettings {
-    /// The workload model the figures use (the first model if absent).
+    /// The workload model the figures use (the run's first model if it has
+    /// none of this name).
     pub model: String,
     /// The w_task whose chosen hyperparameters the figures use (the first
-    /// w_task if absent).
+    /// scored w_task if this one is not scored).
     pub w_task: f64,
     /// The method whose gap and threshold are plotted over one episode.
     pub rollout: String,

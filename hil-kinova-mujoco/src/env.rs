@@ -133,21 +133,29 @@ impl KinovaFeedingConfig {
     }
 }
 
+impl KinovaFeedingConfig {
+    /// This config with a custom scene (`mjcf`) resolved against the
+    /// config file's directory, as every build from `ctx` needs it.
+    pub fn resolved(&self, ctx: &BuildContext) -> Self {
+        let mut cfg = self.clone();
+        cfg.mjcf = cfg.mjcf.map(|p| ctx.resolve(&p));
+        cfg
+    }
+}
+
 #[typetag::serde(name = "kinova_feeding")]
 impl EnvironmentConfig for KinovaFeedingConfig {
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Environment>> {
-        let mut cfg = self.clone();
-        cfg.mjcf = cfg.mjcf.map(|p| ctx.resolve(&p));
-        Ok(Box::new(KinovaFeedingEnv::new(cfg)?))
+        Ok(Box::new(KinovaFeedingEnv::new(self.resolved(ctx))?))
     }
 
     fn pretraining(&self, ctx: &BuildContext) -> Result<Option<Arc<[LabelledObservation]>>> {
         if self.pretraining_trials == 0 {
             return Ok(None);
         }
-        let mut cfg = self.clone();
-        cfg.mjcf = cfg.mjcf.map(|p| ctx.resolve(&p));
-        Ok(Some(simulated_pretraining(&cfg, ctx.seed)?.into()))
+        Ok(Some(
+            simulated_pretraining(&self.resolved(ctx), ctx.seed)?.into(),
+        ))
     }
 }
 

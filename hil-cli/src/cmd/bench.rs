@@ -209,7 +209,8 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
     let pretrain_s = t0.elapsed().as_secs_f64();
     policy.seed(a.seed);
     // The built-in policies' memory traffic, read off a twin of their
-    // estimator built from the same options and data.
+    // estimator: same options and data, so the build context's memo hands
+    // back the estimator the policy was built from (no second pretraining).
     let traffic = match EstimatorConfig::from_policy_table(&table)? {
         Some(est) => Some(Traffic::of(&est.build_estimator(&ctx)?)?),
         None => None,

@@ -294,12 +294,10 @@ fn kinova_scene(cfg: &UserStudyConfig, base: &Path) -> Result<Option<KinovaFeedi
         return Ok(None);
     }
     table.remove("type");
-    let mut scene: KinovaFeedingConfig = value
+    let scene: KinovaFeedingConfig = value
         .try_into()
         .map_err(|e| HilError::serde("environment", e))?;
-    // As the config's own build does: a custom scene is relative to the file.
-    scene.mjcf = scene.mjcf.map(|p| cfg.context(base).resolve(&p));
-    KinovaFeedingEnv::new(scene).map(Some)
+    KinovaFeedingEnv::new(scene.resolved(&cfg.context(base))).map(Some)
 }
 
 fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {

@@ -238,8 +238,7 @@ fn one() -> usize {
 impl ExperimentConfig {
     /// Reads and validates an experiment file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| crate::HilError::io("reading", path, e))?;
+        let text = crate::files::read_text(path, crate::files::limits::CONFIG)?;
         Ok(Self::parse(&text, path)?)
     }
 

@@ -31,6 +31,7 @@ pub mod decision;
 pub mod environment;
 pub mod error;
 pub mod experiment;
+pub mod files;
 pub mod metrics;
 pub mod plugin;
 pub mod policy;

@@ -280,8 +280,7 @@ impl FoodDataset {
             .parent()
             .map(Path::to_path_buf)
             .unwrap_or_default();
-        let text = std::fs::read_to_string(&manifest_path)
-            .map_err(|e| HilError::io("reading", &manifest_path, e))?;
+        let text = hil_core::files::read_text(&manifest_path, hil_core::files::limits::MANIFEST)?;
         let m: Manifest = hil_core::config::parse_toml(&text, &manifest_path)?;
         let actions = ActionSpace::new(m.actions.clone())
             .map_err(|e| data_err(&manifest_path, 0, "actions", e.to_string()))?;

@@ -102,7 +102,7 @@ fn bad(path: &Path, field: &str, why: impl Into<String>) -> HilError {
 
 /// Reads a `.npy` file.
 pub fn read_npy(path: &Path) -> Result<NpyArray> {
-    let bytes = std::fs::read(path).map_err(|e| HilError::io("reading", path, e))?;
+    let bytes = hil_core::files::read_bytes(path, hil_core::files::limits::ARRAY)?;
     read_npy_bytes(&bytes, path)
 }
 

@@ -174,7 +174,7 @@ impl ProtocolSettings {
     /// The `plugins = [...]` the file lists are loaded first, so methods may
     /// name plugin policy types.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
+        let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
         hil_core::config::load_plugins(&text, path)?;
         Ok(hil_core::config::parse_toml(&text, path)?)
     }

@@ -353,7 +353,7 @@ fn load_image(dir: &std::path::Path, label: &str) -> Result<Option<(Vec<u8>, &'s
                 format!("it has {len} bytes, more than the {MAX_IMAGE_BYTES} a page may show"),
             ));
         }
-        let bytes = std::fs::read(&path).map_err(|e| HilError::io("reading", &path, e))?;
+        let bytes = hil_core::files::read_bytes(&path, hil_core::files::limits::ASSET)?;
         return Ok(Some((bytes, content_type)));
     }
     Ok(None)

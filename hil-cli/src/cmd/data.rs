@@ -67,7 +67,7 @@ pub fn run(args: DataArgs) -> hil_core::Result<()> {
 fn generate(a: GenerateArgs) -> hil_core::Result<()> {
     let mut g = match &a.generator {
         Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| HilError::io("reading", p, e))?;
+            let text = hil_core::files::read_text(p, hil_core::files::limits::CONFIG)?;
             hil_core::config::parse_toml::<SyntheticFoods>(&text, p)?
         }
         None => SyntheticFoods::default(),

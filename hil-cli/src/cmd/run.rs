@@ -103,8 +103,7 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
     });
     let summary = match start {
         Start::Fresh { config, log } => {
-            let text = std::fs::read_to_string(&config)
-                .map_err(|e| HilError::io("reading", &config, e))?;
+            let text = hil_core::files::read_text(&config, hil_core::files::limits::CONFIG)?;
             let cfg = ExperimentConfig::parse(&text, &config)?;
             // Absolute, so that a resume from another directory finds the
             // same files.

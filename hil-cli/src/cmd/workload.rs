@@ -149,8 +149,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
         } => {
             let cfg = match config {
                 Some(path) => {
-                    let text = std::fs::read_to_string(&path)
-                        .map_err(|e| HilError::io("reading", &path, e))?;
+                    let text = hil_core::files::read_text(&path, hil_core::files::limits::CONFIG)?;
                     serde_json::from_str::<SynthConfig>(&text).map_err(|e| HilError::Data {
                         path: path.clone(),
                         record: e.line(),

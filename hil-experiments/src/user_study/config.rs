@@ -170,7 +170,7 @@ impl UserStudyConfig {
 
     /// Reads and validates a study file (see [`UserStudyConfig::parse`]).
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
+        let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
         Ok(Self::parse(&text, path)?)
     }
 

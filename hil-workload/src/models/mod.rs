@@ -195,7 +195,7 @@ impl FittedModel {
     /// Reads a model file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
+        let text = hil_core::files::read_text(path, hil_core::files::limits::MODEL)?;
         Self::from_json(&text, path)
     }
 

@@ -132,7 +132,7 @@ pub(super) fn parse(table: &toml::Table) -> Result<Box<dyn PolicyConfig>> {
 }
 
 fn read_table(path: &Path) -> Result<toml::Table> {
-    let text = std::fs::read_to_string(path).map_err(|e| HilError::io("reading", path, e))?;
+    let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
     Ok(parse_toml::<toml::Table>(&text, path)?)
 }
 

@@ -20,6 +20,7 @@
 //! published figures**: they are not the paper's results, and every table and
 //! figure says so.
 
+pub mod calibrate;
 pub mod method;
 pub mod output;
 pub mod plot;

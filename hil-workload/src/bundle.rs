@@ -7,7 +7,7 @@ use hil_core::Result;
 use serde::{Deserialize, Serialize};
 
 use crate::datasets::{Dataset, DatasetId, mean_std};
-use crate::models::{FittedModel, GrangerVariant, Provenance};
+use crate::models::{FittedModel, Provenance};
 use crate::select::{Candidate, SelectOptions, SelectionTable, cross_validate, fit_on_all};
 use crate::stats::{Alternative, TestResult, mann_whitney_u};
 use crate::study::Study;
@@ -74,8 +74,10 @@ impl StudySummary {
     }
 }
 
-/// Fits the five bundled models from `study` and returns them with the
-/// selection table on all three datasets.
+/// Fits the bundled study-fitted models (`f1_real`, `f12_real`: the
+/// cross-validation winners on D1 and D12) from `study` and returns them
+/// with the selection table on all three datasets. The simulation models
+/// are calibrated, not fitted (`hil_experiments::calibrate`).
 pub fn build_bundle(
     study: &Study,
     data_label: &str,
@@ -87,11 +89,6 @@ pub fn build_bundle(
         .collect::<Result<_>>()?;
     let refs: Vec<&Dataset> = sets.iter().collect();
     let table = cross_validate(&refs, &Candidate::table(&opts.histories), opts)?;
-    let sim = Candidate::Granger {
-        variant: GrangerVariant::Simulation,
-        h: 10,
-    };
-    let sim_table = cross_validate(&refs, &[sim], opts)?;
     let note = "fitted on synthetic study data calibrated to the paper's published figures; not real participant data";
     // Every bundled model records its data set, size, CV error and how it
     // was chosen, followed by the synthetic-data note.
@@ -103,23 +100,6 @@ pub fn build_bundle(
         note: Some(format!("{how}; {note}")),
     };
     let mut models = Vec::new();
-    for (d, name) in [
-        (&sets[0], "f1_sim"),
-        (&sets[1], "f2_sim"),
-        (&sets[2], "f12_sim"),
-    ] {
-        let (spec, _) = fit_on_all(d, sim, opts)?;
-        let row = sim_table.row(d.id, sim).expect("scored above");
-        models.push(FittedModel::new(
-            name,
-            spec,
-            provenance(
-                d,
-                [row.mean, row.std, row.median],
-                "simulation variant (Granger H = 10, bounds [0.05, 1], w_0 ≤ 1)".into(),
-            ),
-        ));
-    }
     for (d, name) in [(&sets[0], "f1_real"), (&sets[2], "f12_real")] {
         let best = table.best(d.id).expect("table has rows");
         let (spec, lambda) = fit_on_all(d, best.candidate, opts)?;

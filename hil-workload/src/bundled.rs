@@ -1,12 +1,16 @@
-//! Models shipped with the crate, fitted from the bundled synthetic study
-//! (`data/synthetic_study.csv`, calibrated to the paper's published figures;
-//! not real participant data).
+//! Models shipped with the crate.
 //!
-//! - `f1_sim`, `f2_sim`, `f12_sim`: the simulation variant (Granger H = 10,
-//!   γ and every w_i in [0.05, 1], w_0 ≤ 1) on D1, D2, D12;
-//! - `f1_real`, `f12_real`: the cross-validation winners on D1 and D12.
-//!
-//! Regenerate with `hil workload bundle` (see the crate README).
+//! - `f1_sim`, `f2_sim`, `f12_sim` and their `_steep` variants: the
+//!   simulation models (Granger H = 10, γ and every w_i in [0.05, 1],
+//!   w_0 ≤ 1), *calibrated* to the paper's published simulation rows, not
+//!   fitted: the rows leave the trade-off between the no-query level and the
+//!   per-query increment open, and the plain names take its lean end, the
+//!   `_steep` names its other end. Regenerate with `hil workload calibrate`
+//!   (derivation: `hil_experiments::calibrate`).
+//! - `f1_real`, `f12_real`: the cross-validation winners on D1 and D12 of
+//!   the bundled synthetic study (`data/synthetic_study.csv`, calibrated to
+//!   the paper's published figures; not real participant data). Regenerate
+//!   with `hil workload bundle` (see the crate README).
 
 use std::sync::Arc;
 
@@ -15,7 +19,16 @@ use hil_core::{HilError, Result, WorkloadModel};
 use crate::models::FittedModel;
 
 /// Names of the bundled models.
-pub const NAMES: [&str; 5] = ["f1_sim", "f2_sim", "f12_sim", "f1_real", "f12_real"];
+pub const NAMES: [&str; 8] = [
+    "f1_sim",
+    "f2_sim",
+    "f12_sim",
+    "f1_sim_steep",
+    "f2_sim_steep",
+    "f12_sim_steep",
+    "f1_real",
+    "f12_real",
+];
 
 /// The JSON text of a bundled model.
 pub fn json(name: &str) -> Option<&'static str> {
@@ -23,6 +36,9 @@ pub fn json(name: &str) -> Option<&'static str> {
         "f1_sim" => include_str!("../models/f1_sim.json"),
         "f2_sim" => include_str!("../models/f2_sim.json"),
         "f12_sim" => include_str!("../models/f12_sim.json"),
+        "f1_sim_steep" => include_str!("../models/f1_sim_steep.json"),
+        "f2_sim_steep" => include_str!("../models/f2_sim_steep.json"),
+        "f12_sim_steep" => include_str!("../models/f12_sim_steep.json"),
         "f1_real" => include_str!("../models/f1_real.json"),
         "f12_real" => include_str!("../models/f12_real.json"),
         _ => return None,

@@ -99,7 +99,19 @@ enum WorkloadCommand {
         #[arg(long)]
         svg: Option<PathBuf>,
     },
-    /// Regenerate the bundled study and models (run from the workspace root).
+    /// Derive the simulation models (f1_sim, f2_sim, f12_sim and their
+    /// `_steep` variants) from the paper's published rows, print how each
+    /// meets its targets, and write them (run from the workspace root).
+    Calibrate {
+        /// The hil-workload crate directory.
+        #[arg(long, default_value = "hil-workload")]
+        dir: PathBuf,
+        /// Only compare with the files there; fail if any differs.
+        #[arg(long)]
+        check: bool,
+    },
+    /// Regenerate the bundled study and the study-fitted models
+    /// (f1_real, f12_real; run from the workspace root).
     Bundle {
         /// The hil-workload crate directory.
         #[arg(long, default_value = "hil-workload")]
@@ -307,6 +319,32 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 let svg = hil_experiments::plot::workload_curve_svg(&title, &note, &wl, &asked);
                 write(&path, &svg)?;
                 eprintln!("wrote {}", path.display());
+            }
+            Ok(())
+        }
+        WorkloadCommand::Calibrate { dir, check } => {
+            print!("{}", hil_experiments::calibrate::report()?);
+            let mut stale = Vec::new();
+            for m in hil_experiments::calibrate::all()? {
+                let path = dir.join(format!("models/{}.json", m.name));
+                if check {
+                    let on_disk = hil_core::files::read_text(&path, hil_core::files::limits::MODEL)?;
+                    if on_disk != m.to_json() {
+                        stale.push(path.display().to_string());
+                    }
+                } else {
+                    m.save(&path)?;
+                    eprintln!("wrote {}", path.display());
+                }
+            }
+            if !stale.is_empty() {
+                return Err(HilError::invalid_input(
+                    "calibrated models",
+                    format!(
+                        "{} differ from the calibration; rerun `hil workload calibrate`",
+                        stale.join(", ")
+                    ),
+                ));
             }
             Ok(())
         }

@@ -1,5 +1,7 @@
 //! LinUCB-ExpDecay: on the first timestep of an item, ask with probability
-//! exp(−c·N), N being the number of items seen so far; otherwise act as LinUCB.
+//! exp(−c·N), N being the item's number counted from 1 (the current item
+//! counts, as in the paper: its f_q of 0.160 for c = 0.8 is exactly the mean
+//! of exp(−0.8·N) over N = 1..5); otherwise act as LinUCB.
 
 mod config;
 mod rng_state;
@@ -38,9 +40,19 @@ impl LinUcbExpDecayParams {
         })
     }
 
-    /// The query probability after `items_seen` items.
-    pub fn query_probability(&self, items_seen: usize) -> f64 {
-        (-self.c * items_seen as f64).exp()
+    /// The query probability exp(−c·N) at the first timestep of item
+    /// number `n` (counted from 1: the first item has N = 1).
+    ///
+    /// ```
+    /// use hil_core::QueryKind;
+    /// use hil_policies::LinUcbExpDecayParams;
+    /// let p = LinUcbExpDecayParams::new(1.0, 0.8, QueryKind::default()).unwrap();
+    /// // The paper's f_q = 0.160 for c = 0.8 over five test items.
+    /// let f_q: f64 = (1..=5).map(|n| p.query_probability(n)).sum::<f64>() / 5.0;
+    /// assert!((f_q - 0.160).abs() < 5e-4);
+    /// ```
+    pub fn query_probability(&self, n: usize) -> f64 {
+        (-self.c * n as f64).exp()
     }
 }
 
@@ -88,7 +100,9 @@ impl QueryRule for LinUcbExpDecayParams {
         if ctx.input.attempt != 0 {
             return Ok(Decision::act(ctx.ucb_arm));
         }
-        let p = self.query_probability(ctx.input.items_seen);
+        // `items_seen` counts the items before this one; the paper's N
+        // counts this one too.
+        let p = self.query_probability(ctx.input.items_seen + 1);
         ctx.diagnostics.query_probability = Some(p);
         // One draw per item's first timestep, whatever p is, so the random
         // stream does not depend on the decay rate.
@@ -108,5 +122,45 @@ impl QueryRule for LinUcbExpDecayParams {
     fn restore_state(rng: &mut ExpDecayRng, saved: Value) -> Result<()> {
         rng.0 = rng_state::restore(saved)?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use hil_core::{Context, DecisionInput, Policy, QueryHistory, QueryKind, WorkloadForecast};
+
+    use super::*;
+    use crate::LinearArms;
+
+    /// Through the policy: the probability at item n's first timestep is
+    /// exp(−c·n) with n counted from 1, so over the paper's five test items
+    /// the expected f_q is the paper's 0.160 (c = 0.8) and 0.440 (c = 0.3).
+    #[test]
+    fn the_current_item_counts_as_in_the_paper() {
+        for (c, paper_f_q) in [(0.8, 0.160), (0.3, 0.440)] {
+            let params = LinUcbExpDecayParams::new(1.0, c, QueryKind::default()).unwrap();
+            let mut p = LinUcbExpDecay::new(params, LinearArms::new(2, 2, 1.0).unwrap());
+            p.seed(1);
+            let x = Context::new(vec![0.0, 1.0]).unwrap();
+            let h = QueryHistory::new();
+            let probs: Vec<f64> = (0..5)
+                .map(|items_seen| {
+                    let input = DecisionInput {
+                        context: &x,
+                        t: 1 + items_seen as u64,
+                        item_index: items_seen,
+                        items_seen,
+                        attempt: 0,
+                        workload: WorkloadForecast::none(&h),
+                    };
+                    p.decide(&input).unwrap().diagnostics.query_probability.unwrap()
+                })
+                .collect();
+            for (i, q) in probs.iter().enumerate() {
+                assert!((q - (-c * (i + 1) as f64).exp()).abs() < 1e-12);
+            }
+            let f_q = probs.iter().sum::<f64>() / 5.0;
+            assert!((f_q - paper_f_q).abs() < 5e-4, "c = {c}: {f_q}");
+        }
     }
 }

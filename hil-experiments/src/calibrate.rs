@@ -304,12 +304,8 @@ pub fn calibrate(targets: &Targets, end: End) -> Result<FittedModel> {
         v,
         hil_workload::features::n_columns(HISTORY) - 2,
     ));
-    let spec = GrangerModel::from_coefficients(
-        GrangerVariant::Simulation,
-        HISTORY,
-        &coefficients,
-        None,
-    )?;
+    let spec =
+        GrangerModel::from_coefficients(GrangerVariant::Simulation, HISTORY, &coefficients, None)?;
     let dataset = targets.model.trim_end_matches("_sim").replace('f', "d");
     Ok(FittedModel::new(
         end.model_name(&targets.model),
@@ -370,7 +366,12 @@ pub fn check(model: &FittedModel, targets: &Targets) -> Result<Vec<Readout>> {
         }
         m.predict(targets.wl0, &h, s.t_final)
     };
-    let longest = targets.schedules.iter().map(|s| s.t_final).max().unwrap_or(1);
+    let longest = targets
+        .schedules
+        .iter()
+        .map(|s| s.t_final)
+        .max()
+        .unwrap_or(1);
     let mut out = vec![Readout {
         what: "LinUCB, no query".into(),
         paper: targets.no_query,

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use hil_core::{HilError, Result};
 use serde::Serialize;
 
-use crate::plot::{rollout_svg, workload_comparison_svg};
+use crate::plot::{frontier_svg, rollout_svg, workload_comparison_svg};
 use crate::report::tables_markdown;
-use crate::results::ProtocolResults;
+use crate::results::Reproduction;
 use crate::testbed::{NamedModel, Phase, RunRecord};
 
 /// Where the time went.
@@ -27,7 +27,7 @@ pub struct Timing {
 #[derive(Serialize)]
 struct ResultsFile<'a> {
     #[serde(flatten)]
-    results: &'a ProtocolResults,
+    results: &'a Reproduction,
     timing: &'a Timing,
     delta_wl_definition: &'static str,
 }
@@ -47,8 +47,11 @@ fn write(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|e| HilError::io("writing", path, e))
 }
 
-/// Writes `results.json`, `tables.md`, `rollout.svg` and `workload.svg`
-/// into `dir`. The figures follow the settings' [`FigureSettings`]
+/// Writes `results.json` (both runs and the frontier), `tables.md` (the
+/// paper-protocol tables, then the many-seed tables), `rollout.svg`,
+/// `workload.svg` and `frontier.svg` into `dir`. The figures follow the
+/// settings' [`FigureSettings`], with hyperparameters as the many-seed run
+/// chose them (the paper-protocol run's if there is none)
 /// (the paper's: LinUCB-QG's gap and threshold, and the workload curves of
 /// the querying methods under the D2 model at w_task = 0.7), with each
 /// method's hyperparameter as chosen for that model and w_task, on test
@@ -58,7 +61,7 @@ fn write(path: &Path, text: &str) -> Result<()> {
 /// [`FigureSettings`]: crate::testbed::FigureSettings
 pub fn write_outputs(
     dir: &Path,
-    results: &ProtocolResults,
+    reproduction: &Reproduction,
     records: &[RunRecord],
     models: &[NamedModel],
     timing: &Timing,
@@ -66,17 +69,21 @@ pub fn write_outputs(
     std::fs::create_dir_all(dir).map_err(|e| HilError::io("creating", dir, e))?;
     let results_path = dir.join("results.json");
     let json = serde_json::to_string_pretty(&ResultsFile {
-        results,
+        results: reproduction,
         timing,
         delta_wl_definition: "paper: f(WL_0, Q_T) - WL_0 with the workload model evaluated at the final timestep T over the episode's query history (hil_core::EpisodeMetrics)",
     })
     .map_err(|e| HilError::serde("results", e))?;
     write(&results_path, &json)?;
     let tables = dir.join("tables.md");
-    write(
-        &tables,
-        &tables_markdown(results, Some(timing.runs_s + timing.setup_s))?,
-    )?;
+    let elapsed = Some(timing.runs_s + timing.setup_s);
+    let mut md = tables_markdown(&reproduction.paper_protocol, elapsed)?;
+    if let Some(many) = &reproduction.many_seeds {
+        md.push('\n');
+        md.push_str(&tables_markdown(many, elapsed)?);
+    }
+    write(&tables, &md)?;
+    let results = reproduction.headline();
 
     let s = &results.settings;
     let fig = &s.figures;
@@ -123,6 +130,20 @@ pub fn write_outputs(
         write(&p, &workload_comparison_svg(&runs, model, &note)?)?;
         figures.push(p);
     }
+    let frontier = dir.join("frontier.svg");
+    let labels: Vec<&str> = s.methods.iter().map(|m| m.label.as_str()).collect();
+    write(
+        &frontier,
+        &frontier_svg(
+            &reproduction.frontier,
+            &labels,
+            &format!(
+                "Synthetic data and workload models, not the paper's; test set, {} environment seeds, mean ± SE.",
+                s.seeds_run()
+            ),
+        ),
+    )?;
+    figures.push(frontier);
     Ok(Written {
         results: results_path,
         tables,

@@ -8,6 +8,7 @@ use std::fmt::Write as _;
 
 use hil_core::{Result, Timestep, WorkloadModel};
 
+use crate::results::FrontierPoint;
 use crate::testbed::RunRecord;
 
 const W: f64 = 760.0;
@@ -35,6 +36,12 @@ impl Panel {
     }
 
     fn frame(&self, out: &mut String, title: &str, ylabel: &str) {
+        self.frame_with(out, title, ylabel, None);
+    }
+
+    /// The frame, with x ticks at integers and the timestep label, or (with
+    /// `xlabel`) five evenly spaced ticks and that label.
+    fn frame_with(&self, out: &mut String, title: &str, ylabel: &str, xlabel: Option<&str>) {
         let (l, r) = (LEFT, W - RIGHT);
         let (t, b) = (self.top, self.top + PANEL_H);
         let _ = writeln!(
@@ -66,14 +73,22 @@ impl Panel {
                 py + 3.0
             );
         }
-        let span = (self.x1 - self.x0).max(1.0);
-        let step = (span / 10.0).ceil().max(1.0);
+        let span = (self.x1 - self.x0).max(1e-9);
+        let step = match xlabel {
+            None => (span.max(1.0) / 10.0).ceil().max(1.0),
+            Some(_) => span / 4.0,
+        };
         let mut x = self.x0;
         while x <= self.x1 + 1e-9 {
+            let shown = if xlabel.is_some() {
+                format!("{x:.2}")
+            } else {
+                format!("{x}")
+            };
             let px = self.px(x);
             let _ = writeln!(
                 out,
-                r##"<line x1="{px:.1}" y1="{b}" x2="{px:.1}" y2="{}" stroke="#444"/><text x="{px:.1}" y="{}" font-size="10" text-anchor="middle">{x}</text>"##,
+                r##"<line x1="{px:.1}" y1="{b}" x2="{px:.1}" y2="{}" stroke="#444"/><text x="{px:.1}" y="{}" font-size="10" text-anchor="middle">{shown}</text>"##,
                 b + 4.0,
                 b + 15.0
             );
@@ -81,9 +96,10 @@ impl Panel {
         }
         let _ = writeln!(
             out,
-            r##"<text x="{}" y="{}" font-size="11" text-anchor="middle">timestep t (Δt = 10 s)</text>"##,
+            r##"<text x="{}" y="{}" font-size="11" text-anchor="middle">{}</text>"##,
             (l + r) / 2.0,
-            b + 30.0
+            b + 30.0,
+            esc(xlabel.unwrap_or("timestep t (Δt = 10 s)"))
         );
     }
 
@@ -321,6 +337,110 @@ pub fn workload_curve_svg(title: &str, note: &str, wl: &[f64], queries: &[Timest
             p.px(t as f64),
             p.py(y)
         );
+    }
+    out.push_str("</svg>\n");
+    out
+}
+
+/// Colours of methods, in settings order.
+const METHOD_COLOURS: [&str; 6] = [
+    "#1f5fbf", "#c0392b", "#27ae60", "#8e44ad", "#d35400", "#2c3e50",
+];
+
+/// The trade-off frontier: one panel per model, test r_task against test
+/// ΔWL for every method and grid value (mean ± standard error bars, grid
+/// values joined in order and labelled), so the reader sees what each
+/// hyperparameter buys whichever one validation picks.
+///
+/// ```
+/// use hil_experiments::results::{FrontierPoint, Stat};
+/// let p = |v: f64, r: f64, d: f64| FrontierPoint {
+///     model: "f2_sim".into(),
+///     method: "LinUCB-QG".into(),
+///     point: Some(hil_experiments::results::Hyperparameter { name: "w".into(), value: v }),
+///     n_runs: 3,
+///     r_task_avg: Stat::of(&[r, r + 0.1, r - 0.1]),
+///     delta_wl: Stat::of(&[d, d, d]),
+/// };
+/// let svg = hil_experiments::plot::frontier_svg(&[p(1.0, 0.5, 0.2), p(4.0, 0.3, -0.4)], &["LinUCB-QG"], "synthetic");
+/// assert!(svg.starts_with("<svg") && svg.contains("w = 4"));
+/// ```
+pub fn frontier_svg(points: &[FrontierPoint], methods: &[&str], note: &str) -> String {
+    let mut models: Vec<&str> = Vec::new();
+    for p in points {
+        if !models.contains(&p.model.as_str()) {
+            models.push(&p.model);
+        }
+    }
+    let h = TOP + 34.0 + models.len() as f64 * (PANEL_H + GAP + 10.0) + 20.0;
+    let mut out = figure(h, note);
+    let entries: Vec<(&str, &str)> = methods
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (METHOD_COLOURS[i % METHOD_COLOURS.len()], *m))
+        .collect();
+    legend(&mut out, TOP + 2.0, &entries);
+    for (k, model) in models.iter().enumerate() {
+        let mine: Vec<&FrontierPoint> = points.iter().filter(|p| p.model == *model).collect();
+        let (x0, x1) = mine.iter().fold((-0.5f64, 0.5f64), |(a, b), p| {
+            (
+                a.min(p.delta_wl.mean - p.delta_wl.se),
+                b.max(p.delta_wl.mean + p.delta_wl.se),
+            )
+        });
+        let (y0, y1) = y_range(mine.iter().flat_map(|p| {
+            [
+                p.r_task_avg.mean - p.r_task_avg.se,
+                p.r_task_avg.mean + p.r_task_avg.se,
+            ]
+        }));
+        let panel = Panel {
+            x0,
+            x1,
+            y0,
+            y1,
+            top: TOP + 34.0 + k as f64 * (PANEL_H + GAP + 10.0),
+        };
+        panel.frame_with(
+            &mut out,
+            &format!("{model}: test r_task,avg against ΔWL, every grid value"),
+            "r_task,avg",
+            Some("ΔWL = f(WL_0, Q_T) − WL_0"),
+        );
+        for (i, method) in methods.iter().enumerate() {
+            let colour = METHOD_COLOURS[i % METHOD_COLOURS.len()];
+            let pts: Vec<&&FrontierPoint> = mine.iter().filter(|p| p.method == *method).collect();
+            let line: Vec<(f64, f64)> = pts
+                .iter()
+                .map(|p| (p.delta_wl.mean, p.r_task_avg.mean))
+                .collect();
+            panel.polyline(&mut out, &line, colour, true);
+            for p in pts {
+                let (cx, cy) = (panel.px(p.delta_wl.mean), panel.py(p.r_task_avg.mean));
+                let (ex0, ex1) = (
+                    panel.px(p.delta_wl.mean - p.delta_wl.se),
+                    panel.px(p.delta_wl.mean + p.delta_wl.se),
+                );
+                let (ey0, ey1) = (
+                    panel.py(p.r_task_avg.mean - p.r_task_avg.se),
+                    panel.py(p.r_task_avg.mean + p.r_task_avg.se),
+                );
+                let _ = writeln!(
+                    out,
+                    r##"<line x1="{ex0:.1}" y1="{cy:.1}" x2="{ex1:.1}" y2="{cy:.1}" stroke="{colour}"/><line x1="{cx:.1}" y1="{ey0:.1}" x2="{cx:.1}" y2="{ey1:.1}" stroke="{colour}"/><circle cx="{cx:.1}" cy="{cy:.1}" r="3.5" fill="{colour}"/>"##
+                );
+                if let Some(hp) = &p.point {
+                    let _ = writeln!(
+                        out,
+                        r##"<text x="{:.1}" y="{:.1}" font-size="9" fill="{colour}">{} = {}</text>"##,
+                        cx + 5.0,
+                        cy - 4.0,
+                        esc(&hp.name),
+                        hp.value
+                    );
+                }
+            }
+        }
     }
     out.push_str("</svg>\n");
     out

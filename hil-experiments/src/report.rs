@@ -6,10 +6,10 @@ use std::fmt::Write as _;
 use hil_core::Result;
 
 use crate::published::{self, PublishedRow};
-use crate::results::{MetricSummary, ProtocolResults, Stat};
+use crate::results::{MetricSummary, ProtocolResults, Spread, Stat};
 
-fn pm(s: Stat) -> String {
-    format!("{:.3} ± {:.3}", s.mean, s.std)
+fn pm(s: Stat, spread: Spread) -> String {
+    format!("{:.3} ± {:.3}", s.mean, s.spread(spread))
 }
 
 fn ppm(m: f64, s: f64) -> String {
@@ -44,6 +44,7 @@ fn hyper(r: &crate::results::ResultRow) -> String {
 /// Renders the whole report.
 pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<String> {
     let s = &res.settings;
+    let sp = res.spread;
     let published = published::tables()?;
     let labels: Vec<&str> = s.methods.iter().map(|m| m.label.as_str()).collect();
     let grids: Vec<String> = s
@@ -56,7 +57,18 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<
         })
         .collect();
     let mut o = String::new();
-    let _ = writeln!(o, "# Simulated testbed: our results beside the paper's\n");
+    let _ = match sp {
+        Spread::Std => writeln!(
+            o,
+            "# Simulated testbed, the paper's protocol ({} seeds): our results beside the paper's\n",
+            res.n_env_seeds
+        ),
+        Spread::Se => writeln!(
+            o,
+            "# Simulated testbed, {} seeds (mean ± standard error): our results beside the paper's\n",
+            res.n_env_seeds
+        ),
+    };
     let _ = writeln!(
         o,
         "> **Data provenance.** {}\n>\n> These numbers come from synthetic data and synthetic workload models calibrated to published figures. They are not the paper's results; the columns marked *paper* are the published numbers, shown for comparison.\n",
@@ -71,7 +83,7 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<
         s.items_per_episode,
         s.session.n_att,
         s.session.wl0,
-        s.n_seeds,
+        res.n_env_seeds,
         s.n_policy_seeds,
         s.seed,
         if grids.is_empty() {
@@ -84,7 +96,12 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<
     );
     let _ = writeln!(
         o,
-        "ΔWL everywhere is the paper's definition: ΔWL = f(WL_0, Q_T) − WL_0, the workload model evaluated at the episode's final timestep T over its whole query history. Means ± population standard deviations over runs (seeds × policy seeds).\n"
+        "ΔWL everywhere is the paper's definition: ΔWL = f(WL_0, Q_T) − WL_0, the workload model evaluated at the episode's final timestep T over its whole query history. {} over runs ({} environment seeds × policy seeds). A `_steep` model is the other end of the calibrated model it is named after and is shown beside the same paper rows.\n",
+        match sp {
+            Spread::Std => "Means ± population standard deviations (as the paper reports)",
+            Spread::Se => "Means ± standard errors of the mean",
+        },
+        res.n_env_seeds
     );
 
     // Table I.
@@ -99,17 +116,17 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<
         for m in &res.models {
             for f in &labels {
                 if let Some(r) = res.row(m, w_main, f) {
-                    let p = published.by_w_task(m, w_main, f);
+                    let p = published.by_w_task(s.paper_name(m), w_main, f);
                     let _ = writeln!(
                         o,
                         "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                         model_title(m),
                         f,
-                        pm(r.test.r_task_avg),
+                        pm(r.test.r_task_avg, sp),
                         opt(paper(p, "r_task_avg")),
-                        pm(r.test.m_wt),
+                        pm(r.test.m_wt, sp),
                         opt(paper(p, "m_wt")),
-                        pm(r.test.f_q),
+                        pm(r.test.f_q, sp),
                         opt(paper(p, "f_q")),
                         hyper(r)
                     );
@@ -126,20 +143,20 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<
         for m in &res.models {
             for f in &labels {
                 if let Some(r) = res.row(m, w_main, f) {
-                    let p = published.convergence(m, w_main, f);
+                    let p = published.convergence(s.paper_name(m), w_main, f);
                     let t = &r.test;
                     let _ = writeln!(
                         o,
                         "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                         model_title(m),
                         f,
-                        pm(t.delta_wl),
+                        pm(t.delta_wl, sp),
                         opt(paper(p, "delta_wl")),
-                        pm(t.t_conv),
+                        pm(t.t_conv, sp),
                         opt(paper(p, "t_conv")),
-                        pm(t.f_fail_food),
+                        pm(t.f_fail_food, sp),
                         opt(paper(p, "f_fail_food")),
-                        pm(t.f_auto_food),
+                        pm(t.f_auto_food, sp),
                         opt(paper(p, "f_auto_food")),
                     );
                 }
@@ -172,23 +189,27 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<
                 .fold(f64::NEG_INFINITY, f64::max);
             let best_paper = labels
                 .iter()
-                .filter_map(|f| published.by_w_task(m, w, f).and_then(|r| r.get("m_wt")))
+                .filter_map(|f| {
+                    published
+                        .by_w_task(s.paper_name(m), w, f)
+                        .and_then(|r| r.get("m_wt"))
+                })
                 .map(|v| v.0)
                 .fold(f64::NEG_INFINITY, f64::max);
             for r in ours {
-                let p = published.by_w_task(m, w, &r.method);
+                let p = published.by_w_task(s.paper_name(m), w, &r.method);
                 let bold = |s: String, b: bool| if b { format!("**{s}**") } else { s };
                 let _ = writeln!(
                     o,
                     "| {w:.1} | {} | {} | {} | {} | {} | {} | {} | {} |",
                     r.method,
-                    pm(r.test.r_task_avg),
+                    pm(r.test.r_task_avg, sp),
                     opt(paper(p, "r_task_avg")),
-                    bold(pm(r.test.m_wt), r.test.m_wt.mean == best_ours),
+                    bold(pm(r.test.m_wt, sp), r.test.m_wt.mean == best_ours),
                     opt(p
                         .and_then(|p| p.get("m_wt"))
                         .map(|v| bold(ppm(v.0, v.1), v.0 == best_paper))),
-                    pm(r.test.f_q),
+                    pm(r.test.f_q, sp),
                     opt(paper(p, "f_q")),
                     hyper(r)
                 );
@@ -220,8 +241,18 @@ pub fn tables_markdown(res: &ProtocolResults, elapsed_s: Option<f64>) -> Result<
         let metric = |name: &str, get: &dyn Fn(&MetricSummary) -> Stat, figure: &str| {
             let mut line = format!("| {name} |");
             for c in &res.cross {
-                let p = published.cross(&c.decide, &c.score, s.cross_w_task, &c.method);
-                let _ = write!(line, " {} | {} |", pm(get(&c.test)), opt(paper(p, figure)));
+                let p = published.cross(
+                    s.paper_name(&c.decide),
+                    s.paper_name(&c.score),
+                    s.cross_w_task,
+                    &c.method,
+                );
+                let _ = write!(
+                    line,
+                    " {} | {} |",
+                    pm(get(&c.test), sp),
+                    opt(paper(p, figure))
+                );
             }
             line
         };

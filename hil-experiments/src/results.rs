@@ -10,20 +10,56 @@ use hil_core::EpisodeMetrics;
 use crate::method::GridPoint;
 use crate::testbed::{NamedModel, Phase, ProtocolSettings, RunRecord};
 
-/// Mean and (population) standard deviation over runs.
+/// Mean, population standard deviation (what the paper's ± reports) and
+/// standard error of the mean over runs.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Stat {
     /// Mean.
     pub mean: f64,
-    /// Standard deviation.
+    /// Population standard deviation.
     pub std: f64,
+    /// Standard error of the mean: sample standard deviation / √n (0 for
+    /// fewer than two runs).
+    pub se: f64,
 }
 
 impl Stat {
-    fn of(xs: &[f64]) -> Self {
+    /// The statistics of `xs`.
+    ///
+    /// ```
+    /// let s = hil_experiments::results::Stat::of(&[1.0, 2.0, 3.0]);
+    /// assert_eq!((s.mean, s.std), (2.0, (2.0f64 / 3.0).sqrt()));
+    /// assert!((s.se - 1.0 / 3f64.sqrt()).abs() < 1e-12);
+    /// ```
+    pub fn of(xs: &[f64]) -> Self {
         let (mean, std) = mean_std(xs);
-        Self { mean, std }
+        let n = xs.len() as f64;
+        let se = if xs.len() > 1 {
+            // population variance × n/(n−1) is the sample variance.
+            (std * std * n / (n - 1.0)).sqrt() / n.sqrt()
+        } else {
+            0.0
+        };
+        Self { mean, std, se }
     }
+
+    /// The spread `spread` asks for.
+    pub fn spread(&self, spread: Spread) -> f64 {
+        match spread {
+            Spread::Std => self.std,
+            Spread::Se => self.se,
+        }
+    }
+}
+
+/// Which spread a table reports after ±.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Spread {
+    /// Population standard deviation over runs (the paper's tables).
+    Std,
+    /// Standard error of the mean.
+    Se,
 }
 
 /// A tuned hyperparameter and its value.
@@ -136,6 +172,11 @@ pub struct CrossRow {
 pub struct ProtocolResults {
     /// Where the data came from.
     pub provenance: String,
+    /// Environment seeds aggregated (the first `n_env_seeds` of the run).
+    pub n_env_seeds: usize,
+    /// The spread the tables report: the paper protocol's population std,
+    /// or the many-seed run's standard error.
+    pub spread: Spread,
     /// Settings used.
     pub settings: ProtocolSettings,
     /// Workload model names, in order.
@@ -160,7 +201,7 @@ impl ProtocolResults {
 }
 
 struct Index<'a> {
-    records: &'a [RunRecord],
+    records: Vec<&'a RunRecord>,
 }
 
 impl<'a> Index<'a> {
@@ -173,6 +214,7 @@ impl<'a> Index<'a> {
                     && r.key.point == cand.0
                     && r.key.decide_model == cand.1
             })
+            .copied()
             .collect()
     }
 }
@@ -237,14 +279,23 @@ fn select(
     Ok((chosen, table))
 }
 
-/// Selects hyperparameters on validation and aggregates test metrics.
+/// Selects hyperparameters on validation and aggregates test metrics over
+/// the first `n_env_seeds` environment seeds of `records`, reporting
+/// `spread` after ±.
 pub fn aggregate(
     settings: &ProtocolSettings,
     models: &[NamedModel],
     records: &[RunRecord],
     provenance: &str,
+    n_env_seeds: usize,
+    spread: Spread,
 ) -> Result<ProtocolResults> {
-    let idx = Index { records };
+    let idx = Index {
+        records: records
+            .iter()
+            .filter(|r| r.key.seed < n_env_seeds)
+            .collect(),
+    };
     let mut rows = Vec::new();
     let mut selection = Vec::new();
     for (m, model) in models.iter().enumerate() {
@@ -304,11 +355,118 @@ pub fn aggregate(
     }
     Ok(ProtocolResults {
         provenance: provenance.to_string(),
+        n_env_seeds,
+        spread,
         settings: settings.clone(),
         models: models.iter().map(|m| m.name.clone()).collect(),
-        n_episodes: records.len(),
+        n_episodes: idx.records.len(),
         rows,
         cross,
         selection,
     })
+}
+
+/// One point of the trade-off frontier: a method at one grid value, its
+/// test r_task against its test ΔWL under one model, whatever validation
+/// would choose.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrontierPoint {
+    /// Scoring (and, for methods that read it, deciding) model.
+    pub model: String,
+    /// The method's label.
+    pub method: String,
+    /// The grid value, if the method is tuned.
+    pub point: Option<Hyperparameter>,
+    /// Test runs aggregated.
+    pub n_runs: usize,
+    /// Test r_task_avg.
+    pub r_task_avg: Stat,
+    /// Test ΔWL.
+    pub delta_wl: Stat,
+}
+
+/// The frontier over every test run in `records`: every (model, method,
+/// grid value).
+pub fn frontier(
+    settings: &ProtocolSettings,
+    models: &[NamedModel],
+    records: &[RunRecord],
+) -> Result<Vec<FrontierPoint>> {
+    let idx = Index {
+        records: records.iter().collect(),
+    };
+    let mut out = Vec::new();
+    for (m, model) in models.iter().enumerate() {
+        for (i, method) in settings.methods.iter().enumerate() {
+            for cand in candidates(&idx, settings, i, m) {
+                let runs = idx.runs(Phase::Test, i, &cand);
+                let scored = score_all(&runs, model)?;
+                let col = |f: &dyn Fn(&EpisodeMetrics) -> f64| {
+                    Stat::of(&scored.iter().map(f).collect::<Vec<_>>())
+                };
+                out.push(FrontierPoint {
+                    model: model.name.clone(),
+                    method: method.label.clone(),
+                    point: Hyperparameter::of(&cand.0),
+                    n_runs: scored.len(),
+                    r_task_avg: col(&|s| s.r_task_avg),
+                    delta_wl: col(&|s| s.delta_wl),
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// What `hil reproduce` reports: the paper's protocol (its seeds, its ±
+/// std), the many-seed run beside it (± standard error), and the frontier.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Reproduction {
+    /// The paper's protocol: `n_seeds` environment seeds.
+    pub paper_protocol: ProtocolResults,
+    /// The many-seed run (`many_seeds` environment seeds), if configured.
+    pub many_seeds: Option<ProtocolResults>,
+    /// Test r_task against ΔWL for every grid value, over every seed run.
+    pub frontier: Vec<FrontierPoint>,
+}
+
+impl Reproduction {
+    /// Aggregates a run of [`crate::Protocol::run_all`].
+    pub fn of(
+        settings: &ProtocolSettings,
+        models: &[NamedModel],
+        records: &[RunRecord],
+        provenance: &str,
+    ) -> Result<Self> {
+        let paper_protocol = aggregate(
+            settings,
+            models,
+            records,
+            provenance,
+            settings.n_seeds,
+            Spread::Std,
+        )?;
+        let many_seeds = if settings.many_seeds > settings.n_seeds {
+            Some(aggregate(
+                settings,
+                models,
+                records,
+                provenance,
+                settings.many_seeds,
+                Spread::Se,
+            )?)
+        } else {
+            None
+        };
+        Ok(Self {
+            paper_protocol,
+            many_seeds,
+            frontier: frontier(settings, models, records)?,
+        })
+    }
+
+    /// The results with uncertainty: the many-seed run if there is one.
+    pub fn headline(&self) -> &ProtocolResults {
+        self.many_seeds.as_ref().unwrap_or(&self.paper_protocol)
+    }
 }

@@ -84,6 +84,12 @@ pub struct ProtocolSettings {
     /// the settings file), so methods may name plugin policy types.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plugins: Vec<PathBuf>,
+    /// The food dataset directory (relative to the settings file); none:
+    /// hil-envs' bundled synthetic dataset.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dataset: Option<PathBuf>,
+    /// The workload models, decision and scoring, in table order.
+    pub models: Vec<ModelSource>,
     /// Food split.
     pub split: FoodSplit,
     /// N_att and WL_0.
@@ -92,8 +98,14 @@ pub struct ProtocolSettings {
     pub items_per_episode: usize,
     /// Master seed; environment and policy seeds derive from it.
     pub seed: u64,
-    /// Number of environment seeds (episodes per configuration).
+    /// Number of environment seeds of the paper's protocol (its tables give
+    /// mean ± population std over these, as the paper's do).
     pub n_seeds: usize,
+    /// Environment seeds of the many-seed run beside it (0: none). Its
+    /// tables give mean ± standard error; its first `n_seeds` seeds are the
+    /// paper-protocol run's, so both come from one set of episodes.
+    #[serde(default)]
+    pub many_seeds: usize,
     /// Policy seeds for stochastic methods.
     pub n_policy_seeds: usize,
     /// The w_task values scored.
@@ -112,21 +124,34 @@ pub struct ProtocolSettings {
 impl ProtocolSettings {
     /// The paper's protocol: 3 seeds, 5 policy seeds, N_att = 10,
     /// WL_0 = 0.5, 5 items per episode, w_task ∈ {0.2, …, 0.9}, the four
-    /// methods, f1-on-f2 and f12-on-f2 at w_task = 0.4. The w and c grids
-    /// are ours (the paper does not list them).
+    /// methods, f1-on-f2 and f12-on-f2 at w_task = 0.4, on both ends of
+    /// the calibrated simulation models (`f*_sim`, `f*_sim_steep`), with a
+    /// 30-seed run beside it for standard errors. The w and c grids are
+    /// ours (the paper does not list them).
     pub fn paper() -> Self {
         let cross = |decide: &str| CrossSetting {
             method: "LinUCB-QG".into(),
             decide: decide.into(),
             score: "f2_sim".into(),
         };
+        let cross_steep = |decide: &str| CrossSetting {
+            method: "LinUCB-QG".into(),
+            decide: format!("{decide}_steep"),
+            score: "f2_sim_steep".into(),
+        };
         Self {
             plugins: Vec::new(),
+            dataset: None,
+            models: hil_workload::bundled::CALIBRATED
+                .iter()
+                .map(|n| ModelSource::bundled(n))
+                .collect(),
             split: FoodSplit::paper(),
             session: SessionSettings::default(),
             items_per_episode: 5,
             seed: 0,
             n_seeds: 3,
+            many_seeds: 30,
             n_policy_seeds: 5,
             w_tasks: (2..=9).map(|k| k as f64 / 10.0).collect(),
             methods: vec![
@@ -140,7 +165,12 @@ impl ProtocolSettings {
                 Method::new("LinUCB-QG", paper_policy("linucb_qg", &[("w", 1.0)]))
                     .tuned("w", &[0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0]),
             ],
-            cross: vec![cross("f1_sim"), cross("f12_sim")],
+            cross: vec![
+                cross("f1_sim"),
+                cross("f12_sim"),
+                cross_steep("f1_sim"),
+                cross_steep("f12_sim"),
+            ],
             cross_w_task: 0.4,
             figures: FigureSettings {
                 model: "f2_sim".into(),
@@ -176,7 +206,50 @@ impl ProtocolSettings {
     pub fn load(path: &Path) -> Result<Self> {
         let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
         hil_core::config::load_plugins(&text, path)?;
-        Ok(hil_core::config::parse_toml(&text, path)?)
+        let mut s: Self = hil_core::config::parse_toml(&text, path)?;
+        // Paths in the file are relative to the file.
+        let base = path.parent().unwrap_or(Path::new(""));
+        if let Some(d) = &mut s.dataset {
+            *d = base.join(&*d);
+        }
+        for m in &mut s.models {
+            if let Some(f) = &mut m.file {
+                *f = base.join(&*f);
+            }
+        }
+        Ok(s)
+    }
+
+    /// The dataset the settings name (the bundled one if none).
+    pub fn load_dataset(&self) -> Result<Arc<FoodDataset>> {
+        match &self.dataset {
+            Some(p) => Ok(Arc::new(FoodDataset::load(p)?)),
+            None => hil_envs::bundled_dataset(),
+        }
+    }
+
+    /// The workload models the settings name, loaded.
+    pub fn load_models(&self) -> Result<Vec<NamedModel>> {
+        self.models
+            .iter()
+            .enumerate()
+            .map(|(i, m)| m.load(i))
+            .collect()
+    }
+
+    /// The name of the paper's model whose published rows `model` is
+    /// compared with (its `paper` field, else its own name).
+    pub fn paper_name<'a>(&'a self, model: &'a str) -> &'a str {
+        self.models
+            .iter()
+            .find(|m| m.name == model)
+            .and_then(|m| m.paper.as_deref())
+            .unwrap_or(model)
+    }
+
+    /// Environment seeds run: the many-seed run's if it has more.
+    pub fn seeds_run(&self) -> usize {
+        self.n_seeds.max(self.many_seeds)
     }
 
     /// Checks the settings against a dataset and the available models.
@@ -245,6 +318,15 @@ impl ProtocolSettings {
         if models.is_empty() {
             return Err(HilError::invalid_input("workload models", "none given"));
         }
+        for (i, m) in models.iter().enumerate() {
+            if models[..i].iter().any(|o| o.name == m.name) {
+                return Err(HilError::invalid_parameter(
+                    format!("models[{i}].name"),
+                    &m.name,
+                    "model names must be unique",
+                ));
+            }
+        }
         for c in &self.cross {
             let m = self.method(&c.method).ok_or_else(|| {
                 HilError::invalid_parameter("cross.method", &c.method, "no method has that label")
@@ -303,6 +385,69 @@ impl ProtocolSettings {
     /// Policy seed `j`.
     pub fn policy_seed(&self, j: usize) -> u64 {
         splitmix(self.seed, 200 + j as u64)
+    }
+}
+
+/// Where a protocol's workload model comes from: a bundled model or a
+/// model file, and the name it is reported under.
+///
+/// ```toml
+/// [[models]]
+/// name = "f2_sim"
+/// bundled = "f2_sim"
+///
+/// [[models]]
+/// name = "ours"
+/// file = "models/our_model.json"   # relative to the settings file
+/// paper = "f2_sim"                  # compare with the paper's f2_sim rows
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSource {
+    /// The name tables and cross settings use.
+    pub name: String,
+    /// A bundled model (`hil_workload::bundled::NAMES`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bundled: Option<String>,
+    /// A model JSON file (`hil workload fit` or `select` writes them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// The paper's model (`f1_sim`, `f2_sim`, `f12_sim`) whose published
+    /// rows this one is shown beside; default: `name`, and for a bundled
+    /// `_steep` variant the model it brackets.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paper: Option<String>,
+}
+
+impl ModelSource {
+    /// A bundled model under its own name; a `_steep` variant is compared
+    /// with the paper's rows of the model it brackets.
+    pub fn bundled(name: &str) -> Self {
+        Self {
+            name: name.into(),
+            bundled: Some(name.into()),
+            file: None,
+            paper: name.strip_suffix("_steep").map(str::to_string),
+        }
+    }
+
+    /// Loads the model; `index` locates errors (`models[i]`).
+    pub fn load(&self, index: usize) -> Result<NamedModel> {
+        let model: Arc<dyn WorkloadModel> = match (&self.bundled, &self.file) {
+            (Some(b), None) => hil_workload::bundled::load(b)?,
+            (None, Some(f)) => Arc::new(hil_workload::FittedModel::load(f)?),
+            _ => {
+                return Err(HilError::invalid_parameter(
+                    format!("models[{index}]"),
+                    &self.name,
+                    "give exactly one of `bundled` (a bundled model's name) or `file` (a model JSON file)",
+                ));
+            }
+        };
+        Ok(NamedModel {
+            name: self.name.clone(),
+            model,
+        })
     }
 }
 
@@ -477,7 +622,7 @@ impl Protocol {
         let mut jobs = Vec::new();
         for phase in [Phase::Validation, Phase::Test] {
             for (method, point, decide_model, n_ps) in &specs {
-                for seed in 0..s.n_seeds {
+                for seed in 0..s.seeds_run() {
                     for policy_seed in 0..*n_ps {
                         jobs.push(RunKey {
                             phase,

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use hil_core::testing::fixtures::CountingWorkload;
 use hil_envs::generate::SyntheticFoods;
 use hil_envs::{FoodDataset, FoodSplit};
-use hil_experiments::results::aggregate;
+use hil_experiments::results::{Reproduction, Spread, aggregate};
 use hil_experiments::testbed::{CrossSetting, Phase, RunKey, RunRecord};
 use hil_experiments::{NamedModel, Protocol, ProtocolSettings};
 
@@ -25,6 +25,7 @@ fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
     );
     let mut settings = ProtocolSettings {
         n_policy_seeds: 3,
+        many_seeds: 0,
         w_tasks: vec![0.2, 0.9],
         cross: vec![CrossSetting {
             method: "LinUCB-QG".into(),
@@ -82,7 +83,7 @@ fn protocol_runs_selects_on_validation_and_is_deterministic() {
         "thread count changed results"
     );
 
-    let res = aggregate(&settings, &models, &recs, "test data").unwrap();
+    let res = aggregate(&settings, &models, &recs, "test data", 3, Spread::Std).unwrap();
     assert_eq!(res.rows.len(), 2 * 2 * 4);
     for r in &res.rows {
         match r.method.as_str() {
@@ -135,13 +136,23 @@ fn protocol_runs_selects_on_validation_and_is_deterministic() {
     assert!((rescored - c.test.delta_wl.mean).abs() < 1e-12);
 
     let dir = std::env::temp_dir().join(format!("hil-experiments-out-{}", std::process::id()));
-    let w = hil_experiments::output::write_outputs(&dir, &res, &recs, &models, &Default::default())
-        .unwrap();
+    let reproduction = Reproduction::of(&settings, &models, &recs, "test data").unwrap();
+    let w = hil_experiments::output::write_outputs(
+        &dir,
+        &reproduction,
+        &recs,
+        &models,
+        &Default::default(),
+    )
+    .unwrap();
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&w.results).unwrap()).unwrap();
-    assert_eq!(v["rows"].as_array().unwrap().len(), 16);
-    assert!(v["provenance"].is_string() && v["timing"].is_object());
-    assert_eq!(w.figures.len(), 2);
+    assert_eq!(v["paper_protocol"]["rows"].as_array().unwrap().len(), 16);
+    assert!(v["many_seeds"].is_null());
+    assert!(v["paper_protocol"]["provenance"].is_string() && v["timing"].is_object());
+    // 2 models × (LinUCB, AQ, 2 c values, 3 w values).
+    assert_eq!(v["frontier"].as_array().unwrap().len(), 2 * 7);
+    assert_eq!(w.figures.len(), 3);
     std::fs::remove_dir_all(&dir).unwrap();
     let md = hil_experiments::report::tables_markdown(&res, Some(1.0)).unwrap();
     assert!(md.contains("synthetic") || md.contains("test data"));
@@ -222,6 +233,39 @@ fn plots_render_runs() {
     let svg = hil_experiments::plot::workload_comparison_svg(&[("a", &rec), ("b", &rec)], m, "n")
         .unwrap();
     assert_eq!(svg.matches("<polyline").count(), 2);
+}
+
+/// The many-seed run extends the paper-protocol run's seeds: its first
+/// `n_seeds` seeds are the same episodes, so the paper-protocol tables are
+/// the same whether or not the many-seed run is beside them.
+#[test]
+fn the_many_seed_run_contains_the_paper_protocol_run() {
+    let (ds, mut settings, models) = setup();
+    settings.methods.truncate(2);
+    settings.cross.clear();
+    settings.figures.rollout = "LinUCB".into();
+    settings.figures.workload = vec!["AlwaysQuery".into()];
+    let alone = Protocol::new(settings.clone(), ds.clone(), models.clone());
+    let alone = Reproduction::of(&settings, &models, &run_all(&alone, 2), "t").unwrap();
+    assert!(alone.many_seeds.is_none());
+    settings.many_seeds = 6;
+    let p = Protocol::new(settings.clone(), ds, models.clone());
+    assert_eq!(p.jobs().unwrap().len(), 2 * 6 * 2);
+    let both = Reproduction::of(&settings, &models, &run_all(&p, 2), "t").unwrap();
+    let many = both.many_seeds.as_ref().unwrap();
+    assert_eq!((many.n_env_seeds, many.spread), (6, Spread::Se));
+    assert_eq!(both.paper_protocol.n_env_seeds, 3);
+    assert_eq!(
+        serde_json::to_value(&both.paper_protocol.rows).unwrap(),
+        serde_json::to_value(&alone.paper_protocol.rows).unwrap()
+    );
+    let r = many.row("fast", 0.9, "AlwaysQuery").unwrap();
+    assert_eq!(r.test.n_runs, 6);
+    let s = r.test.r_task_avg;
+    assert!((s.se - s.std * (6.0f64 / 5.0).sqrt() / 6f64.sqrt()).abs() < 1e-12);
+    // The frontier: every (model, method, grid value), over all 6 seeds.
+    assert_eq!(both.frontier.len(), 2 * 2);
+    assert!(both.frontier.iter().all(|f| f.n_runs == 6));
 }
 
 #[test]

@@ -18,6 +18,21 @@ use hil_core::{HilError, Result, WorkloadModel};
 
 use crate::models::FittedModel;
 
+/// The bundled models fitted from the bundled synthetic study
+/// (`hil workload bundle`).
+pub const STUDY_FITTED: [&str; 2] = ["f1_real", "f12_real"];
+
+/// The bundled simulation models calibrated to the paper's published rows
+/// (`hil workload calibrate`), lean ends first.
+pub const CALIBRATED: [&str; 6] = [
+    "f1_sim",
+    "f2_sim",
+    "f12_sim",
+    "f1_sim_steep",
+    "f2_sim_steep",
+    "f12_sim_steep",
+];
+
 /// Names of the bundled models.
 pub const NAMES: [&str; 8] = [
     "f1_sim",
@@ -73,4 +88,22 @@ pub fn load_fitted(name: &str) -> Result<FittedModel> {
 /// ```
 pub fn load(name: &str) -> Result<Arc<dyn WorkloadModel>> {
     Ok(Arc::new(load_fitted(name)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_the_two_groups() {
+        let both: Vec<&str> = CALIBRATED.iter().chain(&STUDY_FITTED).copied().collect();
+        let mut sorted_names = NAMES.to_vec();
+        let mut sorted_both = both.clone();
+        sorted_names.sort();
+        sorted_both.sort();
+        assert_eq!(sorted_names, sorted_both);
+        for n in NAMES {
+            load_fitted(n).unwrap();
+        }
+    }
 }

@@ -170,7 +170,7 @@ fn bundled_models_are_reproducible_from_the_bundled_study() {
         "/data/synthetic_study.csv"
     ))
     .unwrap();
-    for name in hil_workload::bundled::NAMES {
+    for name in hil_workload::bundled::STUDY_FITTED {
         let m = hil_workload::bundled::load_fitted(name).unwrap();
         let id = DatasetId::parse(m.provenance.dataset.as_deref().unwrap()).unwrap();
         let d = Dataset::build(&study, id).unwrap();

@@ -10,13 +10,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use hil_core::HilError;
-use hil_envs::{FoodDataset, bundled_dataset};
+use hil_envs::FoodDataset;
 use hil_experiments::output::{Timing, write_outputs};
-use hil_experiments::results::aggregate;
-use hil_experiments::{NamedModel, Protocol, ProtocolSettings};
-
-/// The simulation workload models of the paper, by bundled name.
-pub const SIM_MODELS: [&str; 3] = ["f1_sim", "f2_sim", "f12_sim"];
+use hil_experiments::results::Reproduction;
+use hil_experiments::{Protocol, ProtocolSettings};
 
 /// Arguments of `hil reproduce`.
 #[derive(Debug, clap::Args)]
@@ -35,9 +32,14 @@ pub struct ReproduceArgs {
     /// it lists are loaded first), instead of the paper's (or --quick) settings.
     #[arg(long)]
     pub settings: Option<PathBuf>,
-    /// A food dataset directory instead of the bundled synthetic one.
+    /// A food dataset directory instead of the settings' (default: the
+    /// bundled synthetic one).
     #[arg(long)]
     pub dataset: Option<PathBuf>,
+    /// Environment seeds of the many-seed run beside the paper's 3-seed
+    /// protocol (default 30; 0 for none).
+    #[arg(long)]
+    pub many_seeds: Option<usize>,
     /// Sets `alpha` (UCB confidence weight) in every method whose policy
     /// config has one (the paper's methods: 0.5; the paper does not state it).
     #[arg(long)]
@@ -55,15 +57,18 @@ pub struct ReproduceArgs {
 
 pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
     let t0 = Instant::now();
-    let dataset: Arc<FoodDataset> = match &args.dataset {
-        Some(p) => Arc::new(FoodDataset::load(p)?),
-        None => bundled_dataset()?,
-    };
     let mut settings = match &args.settings {
         Some(p) => ProtocolSettings::load(p)?,
         None if args.quick => ProtocolSettings::quick(),
         None => ProtocolSettings::paper(),
     };
+    if let Some(d) = &args.dataset {
+        settings.dataset = Some(d.clone());
+    }
+    if let Some(n) = args.many_seeds {
+        settings.many_seeds = n;
+    }
+    let dataset: Arc<FoodDataset> = settings.load_dataset()?;
     if let Some(s) = args.seed {
         settings.seed = s;
     }
@@ -76,15 +81,7 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
             }
         }
     }
-    let models = SIM_MODELS
-        .iter()
-        .map(|n| {
-            Ok(NamedModel {
-                name: n.to_string(),
-                model: hil_workload::bundled::load(n)?,
-            })
-        })
-        .collect::<hil_core::Result<Vec<_>>>()?;
+    let models = settings.load_models()?;
     settings.validate(&dataset, &models)?;
     let protocol = Protocol::new(settings.clone(), dataset.clone(), models.clone());
     let threads = args
@@ -115,7 +112,7 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
     let runs_s = t1.elapsed().as_secs_f64();
 
     let t2 = Instant::now();
-    let results = aggregate(&settings, &models, &records, &dataset.provenance)?;
+    let reproduction = Reproduction::of(&settings, &models, &records, &dataset.provenance)?;
     let mut timing = Timing {
         setup_s,
         runs_s,
@@ -123,9 +120,9 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         threads,
     };
     // Write once to measure, then again with the report time included.
-    write_outputs(&args.out, &results, &records, &models, &timing)?;
+    write_outputs(&args.out, &reproduction, &records, &models, &timing)?;
     timing.report_s = t2.elapsed().as_secs_f64();
-    let written = write_outputs(&args.out, &results, &records, &models, &timing)?;
+    let written = write_outputs(&args.out, &reproduction, &records, &models, &timing)?;
 
     if !args.quiet {
         eprintln!(
@@ -137,19 +134,29 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         );
         eprintln!("data: {}", dataset.provenance);
         let plot_w = settings.figure_w_task();
-        println!("w_task = {plot_w} (test set; synthetic data, not the paper's results):");
+        let results = reproduction.headline();
+        println!(
+            "w_task = {plot_w}, test set, {} environment seeds, mean ± {} (synthetic data, not the paper's results):",
+            results.n_env_seeds,
+            match results.spread {
+                hil_experiments::results::Spread::Std => "population std",
+                hil_experiments::results::Spread::Se => "standard error",
+            }
+        );
         for m in &results.models {
             for method in &settings.methods {
                 if let Some(r) = results.row(m, plot_w, &method.label) {
                     println!(
-                        "  {m:<8} {:<16} r_task_avg {:.3} ± {:.3}  ΔWL {:+.3}  M_wt {:.3} ± {:.3}  f_q {:.3}{}",
+                        "  {m:<13} {:<16} r_task_avg {:.3} ± {:.3}  ΔWL {:+.3} ± {:.3}  M_wt {:.3} ± {:.3}  f_q {:.3} ± {:.3}{}",
                         method.label,
                         r.test.r_task_avg.mean,
-                        r.test.r_task_avg.std,
+                        r.test.r_task_avg.spread(results.spread),
                         r.test.delta_wl.mean,
+                        r.test.delta_wl.spread(results.spread),
                         r.test.m_wt.mean,
-                        r.test.m_wt.std,
+                        r.test.m_wt.spread(results.spread),
                         r.test.f_q.mean,
+                        r.test.f_q.spread(results.spread),
                         r.selected
                             .as_ref()
                             .map_or(String::new(), |h| format!("  ({} = {})", h.name, h.value))

@@ -328,7 +328,8 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             for m in hil_experiments::calibrate::all()? {
                 let path = dir.join(format!("models/{}.json", m.name));
                 if check {
-                    let on_disk = hil_core::files::read_text(&path, hil_core::files::limits::MODEL)?;
+                    let on_disk =
+                        hil_core::files::read_text(&path, hil_core::files::limits::MODEL)?;
                     if on_disk != m.to_json() {
                         stale.push(path.display().to_string());
                     }

@@ -153,7 +153,11 @@ mod tests {
                         attempt: 0,
                         workload: WorkloadForecast::none(&h),
                     };
-                    p.decide(&input).unwrap().diagnostics.query_probability.unwrap()
+                    p.decide(&input)
+                        .unwrap()
+                        .diagnostics
+                        .query_probability
+                        .unwrap()
                 })
                 .collect();
             for (i, q) in probs.iter().enumerate() {

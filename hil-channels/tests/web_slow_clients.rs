@@ -165,7 +165,9 @@ fn status(s: &mut TcpStream) -> u16 {
 fn hold(server: &Server, bytes: &[u8], expect: Occupancy) -> TcpStream {
     let mut s = TcpStream::connect(server.addr()).unwrap();
     s.write_all(bytes).unwrap();
-    wait_for("the connection to be placed", || server.occupancy() == expect);
+    wait_for("the connection to be placed", || {
+        server.occupancy() == expect
+    });
     s
 }
 
@@ -181,7 +183,8 @@ fn a_request_still_trickling_at_its_deadline_gets_408() {
     let head = b"GET /secret/ HTTP/1.1\r\nX-Slow: ";
     for i in 0.. {
         assert!(i < 3000, "the server never gave up on the request");
-        if s.write_all(&[head.get(i).copied().unwrap_or(b'x')]).is_err()
+        if s.write_all(&[head.get(i).copied().unwrap_or(b'x')])
+            .is_err()
             || closed_or_answered(&mut s)
         {
             break;
@@ -251,7 +254,9 @@ fn token_holders_have_slots_strangers_cannot_take() {
         s.write_all(b"GET /x").unwrap();
         strangers.push(s);
     }
-    wait_for("the strangers' pool to fill", || server.occupancy().open == 2);
+    wait_for("the strangers' pool to fill", || {
+        server.occupancy().open == 2
+    });
     // They took nothing from the token holder, who finishes the request.
     assert_eq!(server.occupancy().trusted, 1);
     assert!(!closed_or_answered(&mut holder));
@@ -273,9 +278,7 @@ fn token_holders_have_slots_strangers_cannot_take() {
         },
     );
     let mut third = TcpStream::connect(server.addr()).unwrap();
-    third
-        .write_all(b"GET /secret/ HTTP/1.1\r\n\r\n")
-        .unwrap();
+    third.write_all(b"GET /secret/ HTTP/1.1\r\n\r\n").unwrap();
     assert_eq!(status(&mut third), 503);
 }
 
@@ -295,8 +298,8 @@ fn zero_limits_are_refused() {
             ..Limits::default()
         },
     ] {
-        let err = Server::start("127.0.0.1:0".parse().unwrap(), Arc::new(Secret), limits)
-            .unwrap_err();
+        let err =
+            Server::start("127.0.0.1:0".parse().unwrap(), Arc::new(Secret), limits).unwrap_err();
         assert_eq!(err.kind(), ErrorKind::InvalidInput);
     }
 }

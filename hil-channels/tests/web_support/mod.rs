@@ -116,5 +116,9 @@ pub fn open_id(addr: SocketAddr, token: &str) -> u64 {
 
 /// The token in a page URL `http://HOST:PORT/TOKEN/`.
 pub fn token_of(url: &str) -> String {
-    url.trim_end_matches('/').rsplit('/').next().unwrap().to_string()
+    url.trim_end_matches('/')
+        .rsplit('/')
+        .next()
+        .unwrap()
+        .to_string()
 }

@@ -112,6 +112,13 @@ impl RequestParser {
         self.line.as_ref().map(|l| l.path.as_str())
     }
 
+    /// How many bytes the parser holds. While it needs more, never more
+    /// than [`MAX_HEAD_BYTES`] + 4 + [`MAX_BODY_BYTES`]: a connection's
+    /// memory is bounded whatever the client sends.
+    pub fn buffered(&self) -> usize {
+        self.buf.len()
+    }
+
     /// What to answer when the client stops sending before a whole
     /// request: `None` if it sent nothing (it just went away).
     pub fn end_of_input(&self) -> Option<Refusal> {

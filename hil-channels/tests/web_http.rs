@@ -325,22 +325,37 @@ fn no_answer_in_time_times_out_and_says_so() {
 
 #[test]
 fn bad_configs_are_refused() {
+    let refused = |config: WebChannelConfig| match WebChannel::start(config) {
+        Err(hil_core::HilError::InvalidParameter { name, .. }) => name,
+        other => panic!("{other:?}"),
+    };
     for timeout_s in [0.0, -1.0, f64::NAN] {
-        assert!(
-            WebChannel::start(WebChannelConfig {
-                timeout_s,
-                ..Default::default()
-            })
-            .is_err()
-        );
+        let config = WebChannelConfig {
+            timeout_s,
+            ..Default::default()
+        };
+        assert_eq!(refused(config), "timeout_s");
     }
-    let err = WebChannel::start(WebChannelConfig {
+    let config = WebChannelConfig {
         allowed_hosts: vec!["bad host/".into()],
         ..Default::default()
+    };
+    assert_eq!(refused(config), "allowed_hosts");
+    // The port is taken: the error says which address.
+    let (taken, addr, _) = channel(5.0);
+    let err = WebChannel::start(WebChannelConfig {
+        port: addr.port(),
+        ..Default::default()
     })
-    .unwrap_err()
-    .to_string();
-    assert!(err.contains("allowed_hosts"), "{err}");
+    .unwrap_err();
+    match err {
+        hil_core::HilError::Channel { channel, why } => {
+            assert_eq!(channel, "web");
+            assert!(why.contains(&addr.to_string()), "{why}");
+        }
+        other => panic!("{other:?}"),
+    }
+    drop(taken);
 }
 
 /// A person who answers every question over HTTP as the page would.
@@ -434,13 +449,16 @@ fn item_pictures_are_served_for_the_open_question_only() {
     ch.ask(&q).unwrap();
     assert_eq!(person.join().unwrap(), 200);
     drop(ch);
-    let err = WebChannel::start(WebChannelConfig {
+    match WebChannel::start(WebChannelConfig {
         images: Some(dir.join("missing")),
         ..Default::default()
-    })
-    .unwrap_err()
-    .to_string();
-    assert!(err.contains("images") && err.contains("missing"), "{err}");
+    }) {
+        Err(hil_core::HilError::InvalidParameter { name, value, .. }) => {
+            assert_eq!(name, "images");
+            assert!(value.ends_with("missing"), "{value}");
+        }
+        other => panic!("{other:?}"),
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -482,4 +500,33 @@ fn the_printed_urls_are_addresses_the_server_listens_on() {
     // Addresses other devices can use come first; loopback only last.
     let loopback_at = urls.iter().position(|u| u.contains("//127."));
     assert!(loopback_at.is_none_or(|i| i == urls.len() - 1), "{urls:?}");
+}
+
+#[test]
+fn unreadable_pictures_are_errors_naming_the_file() {
+    let dir = std::env::temp_dir().join(format!("hil-web-bad-images-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // Over the asset limit (sparse: no disk space used), and not a file.
+    let big = dir.join("cantaloupe.png");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(hil_core::files::limits::ASSET + 1)
+        .unwrap();
+    std::fs::create_dir(dir.join("banana.jpg")).unwrap();
+    let mut ch = WebChannel::start(WebChannelConfig {
+        timeout_s: 5.0,
+        images: Some(dir.clone()),
+        ..Default::default()
+    })
+    .unwrap();
+    let mut q = query(1, ResponseType::Mcq);
+    for (label, file) in [("cantaloupe", "cantaloupe.png"), ("banana", "banana.jpg")] {
+        q.item.label = label.into();
+        match ch.ask(&q) {
+            Err(hil_core::HilError::Io { path, .. }) => assert_eq!(path, dir.join(file)),
+            other => panic!("{label}: {other:?}"),
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -349,12 +349,11 @@ impl QueryChannel for WebChannel {
     }
 }
 
-/// Largest picture served, in bytes.
-const MAX_IMAGE_BYTES: u64 = 8 * 1024 * 1024;
-
 /// The picture of item `label` in `dir`, if there is one. Labels that are
 /// not plain names (letters, digits, `_`, `-`) never map to a file. SVG is
-/// not served: it can carry scripts.
+/// not served: it can carry scripts. A picture that is not a regular file
+/// or is larger than `hil_core::files::limits::ASSET` is an error (naming
+/// the file), not a question without its picture.
 fn load_image(dir: &std::path::Path, label: &str) -> Result<Option<(Vec<u8>, &'static str)>> {
     if label.is_empty()
         || !label
@@ -370,17 +369,8 @@ fn load_image(dir: &std::path::Path, label: &str) -> Result<Option<(Vec<u8>, &'s
         ("webp", "image/webp"),
     ] {
         let path = dir.join(format!("{label}.{ext}"));
-        if !path.is_file() {
+        if !path.exists() {
             continue;
-        }
-        let len = std::fs::metadata(&path)
-            .map_err(|e| HilError::io("reading", &path, e))?
-            .len();
-        if len > MAX_IMAGE_BYTES {
-            return Err(HilError::invalid_input(
-                format!("picture {}", path.display()),
-                format!("it has {len} bytes, more than the {MAX_IMAGE_BYTES} a page may show"),
-            ));
         }
         let bytes = hil_core::files::read_bytes(&path, hil_core::files::limits::ASSET)?;
         return Ok(Some((bytes, content_type)));

@@ -2,6 +2,8 @@
 //! origins, malformed, oversized and concurrent requests, timeouts, and the
 //! conformance suite with a scripted person answering over HTTP.
 
+mod web_support;
+
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::sync::Arc;
@@ -10,111 +12,8 @@ use std::time::Duration;
 
 use hil_channels::{WebChannel, WebChannelConfig};
 use hil_core::testing::check_query_channel;
-use hil_core::{
-    Answer, ArmId, Context, Item, Query, QueryChannel, QueryKind, Response, ResponseType,
-};
-
-fn channel(timeout_s: f64) -> (WebChannel, SocketAddr, String) {
-    let ch = WebChannel::start(WebChannelConfig {
-        timeout_s,
-        ..Default::default()
-    })
-    .unwrap();
-    let addr = ch.addr();
-    assert!(addr.ip().is_loopback(), "binds to loopback by default");
-    let url = ch.url().to_string();
-    let token = url
-        .trim_end_matches('/')
-        .rsplit('/')
-        .next()
-        .unwrap()
-        .to_string();
-    assert_eq!(token.len(), 32);
-    (ch, addr, token)
-}
-
-/// Sends raw bytes, returns (status, body).
-fn raw(addr: SocketAddr, bytes: &[u8]) -> (u16, String) {
-    let mut s = TcpStream::connect(addr).unwrap();
-    s.set_read_timeout(Some(Duration::from_secs(15))).unwrap();
-    let _ = s.write_all(bytes);
-    let _ = s.shutdown(std::net::Shutdown::Write);
-    let mut out = Vec::new();
-    let _ = s.read_to_end(&mut out);
-    let text = String::from_utf8_lossy(&out).to_string();
-    let status = text
-        .split(' ')
-        .nth(1)
-        .and_then(|c| c.parse().ok())
-        .unwrap_or_else(|| panic!("no status in {text:?}"));
-    let body = text
-        .split_once("\r\n\r\n")
-        .map(|(_, b)| b.to_string())
-        .unwrap_or_default();
-    (status, body)
-}
-
-fn get(addr: SocketAddr, path: &str) -> (u16, String) {
-    raw(
-        addr,
-        format!("GET {path} HTTP/1.1\r\nHost: {addr}\r\n\r\n").as_bytes(),
-    )
-}
-
-fn post(addr: SocketAddr, path: &str, extra_headers: &str, body: &str) -> (u16, String) {
-    raw(
-        addr,
-        format!(
-            "POST {path} HTTP/1.1\r\nHost: {addr}\r\n{extra_headers}Content-Length: {}\r\n\r\n{body}",
-            body.len()
-        )
-        .as_bytes(),
-    )
-}
-
-fn same_origin(addr: SocketAddr) -> String {
-    format!("Origin: http://{addr}\r\nContent-Type: application/json\r\n")
-}
-
-fn query(t: u64, response: ResponseType) -> Query {
-    Query {
-        t,
-        item: Item {
-            index: 0,
-            label: "cantaloupe".into(),
-            description: Some("a cube of cantaloupe".into()),
-        },
-        kind: QueryKind {
-            response,
-            ..Default::default()
-        },
-        actions: hil_envs::feeding::action_space(),
-        context: Context::new(vec![0.1]).unwrap(),
-        oracle_best: Some(ArmId(1)),
-    }
-}
-
-/// Asks `q` on a thread; the handle returns the channel and the response.
-fn ask_async(mut ch: WebChannel, q: Query) -> JoinHandle<(WebChannel, Response)> {
-    std::thread::spawn(move || {
-        let r = ch.ask(&q).unwrap();
-        (ch, r)
-    })
-}
-
-/// Waits until the page has an open question and returns its id.
-fn open_id(addr: SocketAddr, token: &str) -> u64 {
-    for _ in 0..500 {
-        let (s, body) = get(addr, &format!("/{token}/api/query"));
-        assert_eq!(s, 200);
-        let v: serde_json::Value = serde_json::from_str(&body).unwrap();
-        if v["state"] == "query" {
-            return v["id"].as_u64().unwrap();
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    panic!("no question opened");
-}
+use hil_core::{Answer, ArmId, QueryChannel, ResponseType};
+use web_support::{ask_async, channel, get, open_id, post, query, raw, same_origin};
 
 #[test]
 fn tokens_are_required_everywhere() {
@@ -426,22 +325,37 @@ fn no_answer_in_time_times_out_and_says_so() {
 
 #[test]
 fn bad_configs_are_refused() {
+    let refused = |config: WebChannelConfig| match WebChannel::start(config) {
+        Err(hil_core::HilError::InvalidParameter { name, .. }) => name,
+        other => panic!("{other:?}"),
+    };
     for timeout_s in [0.0, -1.0, f64::NAN] {
-        assert!(
-            WebChannel::start(WebChannelConfig {
-                timeout_s,
-                ..Default::default()
-            })
-            .is_err()
-        );
+        let config = WebChannelConfig {
+            timeout_s,
+            ..Default::default()
+        };
+        assert_eq!(refused(config), "timeout_s");
     }
-    let err = WebChannel::start(WebChannelConfig {
+    let config = WebChannelConfig {
         allowed_hosts: vec!["bad host/".into()],
         ..Default::default()
+    };
+    assert_eq!(refused(config), "allowed_hosts");
+    // The port is taken: the error says which address.
+    let (taken, addr, _) = channel(5.0);
+    let err = WebChannel::start(WebChannelConfig {
+        port: addr.port(),
+        ..Default::default()
     })
-    .unwrap_err()
-    .to_string();
-    assert!(err.contains("allowed_hosts"), "{err}");
+    .unwrap_err();
+    match err {
+        hil_core::HilError::Channel { channel, why } => {
+            assert_eq!(channel, "web");
+            assert!(why.contains(&addr.to_string()), "{why}");
+        }
+        other => panic!("{other:?}"),
+    }
+    drop(taken);
 }
 
 /// A person who answers every question over HTTP as the page would.
@@ -496,13 +410,7 @@ fn item_pictures_are_served_for_the_open_question_only() {
     })
     .unwrap();
     let addr = ch.addr();
-    let token = ch
-        .url()
-        .trim_end_matches('/')
-        .rsplit('/')
-        .next()
-        .unwrap()
-        .to_string();
+    let token = web_support::token_of(ch.url());
     let asking = ask_async(ch, query(1, ResponseType::Mcq));
     let id = open_id(addr, &token);
     let (_, body) = get(addr, &format!("/{token}/api/query"));
@@ -541,12 +449,84 @@ fn item_pictures_are_served_for_the_open_question_only() {
     ch.ask(&q).unwrap();
     assert_eq!(person.join().unwrap(), 200);
     drop(ch);
-    let err = WebChannel::start(WebChannelConfig {
+    match WebChannel::start(WebChannelConfig {
         images: Some(dir.join("missing")),
         ..Default::default()
+    }) {
+        Err(hil_core::HilError::InvalidParameter { name, value, .. }) => {
+            assert_eq!(name, "images");
+            assert!(value.ends_with("missing"), "{value}");
+        }
+        other => panic!("{other:?}"),
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_printed_urls_are_addresses_the_server_listens_on() {
+    // Default bind: one loopback URL, and the endpoint says the same.
+    let (ch, addr, token) = channel(5.0);
+    assert_eq!(
+        ch.urls(),
+        [format!("http://127.0.0.1:{}/{token}/", addr.port())]
+    );
+    assert_eq!(ch.endpoint().unwrap(), ch.url());
+    drop(ch);
+    // All interfaces: the machine's addresses, never 0.0.0.0, each serving
+    // the page (no network needed: they are this machine's own).
+    let ch = WebChannel::start(WebChannelConfig {
+        bind: "0.0.0.0".parse().unwrap(),
+        ..Default::default()
     })
-    .unwrap_err()
-    .to_string();
-    assert!(err.contains("images") && err.contains("missing"), "{err}");
+    .unwrap();
+    let urls = ch.urls().to_vec();
+    assert!(!urls.is_empty());
+    assert_eq!(ch.endpoint().unwrap().lines().collect::<Vec<_>>(), urls);
+    assert_eq!(ch.url(), urls[0]);
+    let token = web_support::token_of(ch.url());
+    for url in &urls {
+        let host = url
+            .strip_prefix("http://")
+            .and_then(|u| u.split('/').next())
+            .unwrap();
+        let at: SocketAddr = host.parse().unwrap();
+        assert!(!at.ip().is_unspecified(), "{url}");
+        assert_eq!(at.port(), ch.addr().port(), "{url}");
+        assert_eq!(*url, format!("http://{at}/{token}/"));
+        let (s, html) = get(at, &format!("/{token}/"));
+        assert_eq!(s, 200, "{url}");
+        assert!(html.contains("app.js"), "{url}");
+    }
+    // Addresses other devices can use come first; loopback only last.
+    let loopback_at = urls.iter().position(|u| u.contains("//127."));
+    assert!(loopback_at.is_none_or(|i| i == urls.len() - 1), "{urls:?}");
+}
+
+#[test]
+fn unreadable_pictures_are_errors_naming_the_file() {
+    let dir = std::env::temp_dir().join(format!("hil-web-bad-images-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // Over the asset limit (sparse: no disk space used), and not a file.
+    let big = dir.join("cantaloupe.png");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(hil_core::files::limits::ASSET + 1)
+        .unwrap();
+    std::fs::create_dir(dir.join("banana.jpg")).unwrap();
+    let mut ch = WebChannel::start(WebChannelConfig {
+        timeout_s: 5.0,
+        images: Some(dir.clone()),
+        ..Default::default()
+    })
+    .unwrap();
+    let mut q = query(1, ResponseType::Mcq);
+    for (label, file) in [("cantaloupe", "cantaloupe.png"), ("banana", "banana.jpg")] {
+        q.item.label = label.into();
+        match ch.ask(&q) {
+            Err(hil_core::HilError::Io { path, .. }) => assert_eq!(path, dir.join(file)),
+            other => panic!("{label}: {other:?}"),
+        }
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

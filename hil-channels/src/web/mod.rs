@@ -2,6 +2,7 @@
 //! phone or tablet next to the robot, by touch, keyboard or single switch.
 
 pub mod http;
+pub mod urls;
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
@@ -15,7 +16,7 @@ use hil_core::config::QueryChannelConfig;
 use hil_core::{Answer, ArmId, BuildContext, HilError, Query, QueryChannel, Response, Result};
 
 use crate::present::{describe_item, describe_kind, question, validate_answer};
-use http::{Request, Response as HttpResponse, Server};
+use http::{Limits, Occupancy, Request, Response as HttpResponse, Server, Service};
 
 const PAGE_HTML: &str = include_str!("page.html");
 const PAGE_JS: &str = include_str!("page.js");
@@ -38,6 +39,7 @@ fn default_timeout() -> f64 {
 /// [channel]
 /// type = "web"
 /// bind = "127.0.0.1"     # default; "0.0.0.0" to reach it from a tablet on the LAN
+///                        # (then the machine's addresses are printed, one URL each)
 /// port = 8765            # default 0: any free port (the URL is printed)
 /// timeout_s = 120        # then the robot acts on its own (recorded as timed_out)
 /// allowed_hosts = []     # host names besides IP addresses and localhost
@@ -129,7 +131,11 @@ impl Shared {
 ///
 /// - The server listens on 127.0.0.1 by default; every URL carries a
 ///   per-session random token (`http://127.0.0.1:PORT/TOKEN/`): without it,
-///   or with a wrong one, every request gets 403.
+///   or with a wrong one, every request gets 403. Bound to `0.0.0.0`, it
+///   gives one URL per address of the machine ([`urls`](Self::urls)).
+/// - Clients without the token cannot lock the person out: each request
+///   must arrive whole within 10 s, and requests carrying the token have
+///   connection slots of their own (see [`http`]).
 /// - Answers are accepted only from the page's own origin (`Origin` must
 ///   match `Host`, a JSON body is required, `Host` must be an IP address,
 ///   `localhost` or an allowed name), so another web site open in the same
@@ -151,7 +157,8 @@ impl Shared {
 pub struct WebChannel {
     shared: Arc<Shared>,
     server: Server,
-    url: String,
+    /// Never empty: `start` refuses to run without an address to print.
+    urls: Vec<String>,
 }
 
 impl std::fmt::Debug for WebChannel {
@@ -215,27 +222,34 @@ impl WebChannel {
             state: Mutex::new(State::default()),
             answered: Condvar::new(),
         });
-        let handler_shared = shared.clone();
-        let server = Server::start(
-            bind,
-            Arc::new(move |req: &Request| handle(&handler_shared, req)),
-        )
-        .map_err(|e| HilError::Channel {
+        let channel_error = |why: String| HilError::Channel {
             channel: "web".into(),
-            why: format!("cannot listen on {bind}: {e}"),
-        })?;
+            why,
+        };
+        let server = Server::start(bind, Arc::new(Page(shared.clone())), Limits::default())
+            .map_err(|e| channel_error(format!("cannot listen on {bind}: {e}")))?;
         let addr = server.addr();
         let _ = shared.port.set(addr.port());
-        let host = match addr.ip() {
-            ip if ip.is_unspecified() => "127.0.0.1".to_string(),
-            IpAddr::V6(ip) => format!("[{ip}]"),
-            IpAddr::V4(ip) => ip.to_string(),
-        };
-        let url = format!("http://{host}:{}/{}/", addr.port(), shared.token);
+        let hosts = urls::reachable_hosts(addr.ip()).map_err(|e| {
+            channel_error(format!(
+                "listening on {addr}, but cannot list this machine's addresses to print \
+                 the page's URL ({e}); set `bind` to the address to use"
+            ))
+        })?;
+        if hosts.is_empty() {
+            return Err(channel_error(format!(
+                "listening on {addr}, but this machine has no address of that kind to open \
+                 the page at; set `bind` to the address to use"
+            )));
+        }
+        let urls = hosts
+            .into_iter()
+            .map(|ip| urls::page_url(ip, addr.port(), &shared.token))
+            .collect();
         Ok(Self {
             shared,
             server,
-            url,
+            urls,
         })
     }
 
@@ -244,9 +258,23 @@ impl WebChannel {
         self.server.addr()
     }
 
-    /// The page's URL, token included.
+    /// The page's URL, token included: the first of [`urls`](Self::urls).
     pub fn url(&self) -> &str {
-        &self.url
+        &self.urls[0]
+    }
+
+    /// Every URL the page can be opened at, token included: one per
+    /// address the server listens on (for `bind = "0.0.0.0"`, the
+    /// machine's addresses, those other devices can use first, loopback
+    /// last; see [`urls::reachable_hosts`]).
+    pub fn urls(&self) -> &[String] {
+        &self.urls
+    }
+
+    /// How many connections the server holds now, by pool (strangers,
+    /// token holders): to watch for a flood of connections.
+    pub fn occupancy(&self) -> Occupancy {
+        self.server.occupancy()
     }
 }
 
@@ -255,8 +283,9 @@ impl QueryChannel for WebChannel {
         "web"
     }
 
+    /// The page's URLs, one per line (see [`WebChannel::urls`]).
     fn endpoint(&self) -> Option<String> {
-        Some(self.url.clone())
+        Some(self.urls.join("\n"))
     }
 
     fn ask(&mut self, query: &Query) -> Result<Response> {
@@ -320,12 +349,11 @@ impl QueryChannel for WebChannel {
     }
 }
 
-/// Largest picture served, in bytes.
-const MAX_IMAGE_BYTES: u64 = 8 * 1024 * 1024;
-
 /// The picture of item `label` in `dir`, if there is one. Labels that are
 /// not plain names (letters, digits, `_`, `-`) never map to a file. SVG is
-/// not served: it can carry scripts.
+/// not served: it can carry scripts. A picture that is not a regular file
+/// or is larger than `hil_core::files::limits::ASSET` is an error (naming
+/// the file), not a question without its picture.
 fn load_image(dir: &std::path::Path, label: &str) -> Result<Option<(Vec<u8>, &'static str)>> {
     if label.is_empty()
         || !label
@@ -341,17 +369,8 @@ fn load_image(dir: &std::path::Path, label: &str) -> Result<Option<(Vec<u8>, &'s
         ("webp", "image/webp"),
     ] {
         let path = dir.join(format!("{label}.{ext}"));
-        if !path.is_file() {
+        if !path.exists() {
             continue;
-        }
-        let len = std::fs::metadata(&path)
-            .map_err(|e| HilError::io("reading", &path, e))?
-            .len();
-        if len > MAX_IMAGE_BYTES {
-            return Err(HilError::invalid_input(
-                format!("picture {}", path.display()),
-                format!("it has {len} bytes, more than the {MAX_IMAGE_BYTES} a page may show"),
-            ));
         }
         let bytes = hil_core::files::read_bytes(&path, hil_core::files::limits::ASSET)?;
         return Ok(Some((bytes, content_type)));
@@ -441,9 +460,27 @@ struct AnswerRequest {
     answer: Answer,
 }
 
+/// What the server serves: the page of one channel.
+struct Page(Arc<Shared>);
+
+impl Service for Page {
+    fn trusted(&self, path: &str) -> bool {
+        same_token(split_token(path).0, &self.0.token)
+    }
+
+    fn handle(&self, req: &Request) -> HttpResponse {
+        handle(&self.0, req)
+    }
+}
+
+/// Splits `/TOKEN/rest` into the token and the rest.
+fn split_token(path: &str) -> (&str, &str) {
+    let mut segments = path.trim_start_matches('/').splitn(2, '/');
+    (segments.next().unwrap_or(""), segments.next().unwrap_or(""))
+}
+
 fn handle(shared: &Shared, req: &Request) -> HttpResponse {
-    let mut segments = req.path.trim_start_matches('/').splitn(2, '/');
-    let token = segments.next().unwrap_or("");
+    let (token, rest) = split_token(&req.path);
     if token.is_empty() {
         return forbidden("the address needs the session token");
     }
@@ -457,7 +494,6 @@ fn handle(shared: &Shared, req: &Request) -> HttpResponse {
         Some(h) if host_allowed(shared, port, h) => {}
         _ => return forbidden("unexpected Host"),
     }
-    let rest = segments.next().unwrap_or("");
     let asset = |body: &str, content_type: &'static str| HttpResponse {
         status: 200,
         content_type,

@@ -190,9 +190,12 @@ fn install_interrupt_notice(_log: Option<PathBuf>) {}
 /// Tells the researcher where the person answers (a web channel's URL).
 /// Printed even with --quiet: without it nobody can answer.
 fn announce_endpoint(endpoint: Option<String>) {
-    if let Some(url) = endpoint {
+    if let Some(urls) = endpoint {
         eprintln!("open this address on the phone or tablet to answer the robot's questions:");
-        eprintln!("  {url}");
+        // One line per address (a web page bound to 0.0.0.0 has several).
+        for url in urls.lines() {
+            eprintln!("  {url}");
+        }
     }
 }
 

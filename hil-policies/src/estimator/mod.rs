@@ -365,6 +365,8 @@ impl LinearArms {
             }
         }
         self.after_change();
+        // Pretraining rows are shared by every clone of this estimator.
+        self.store.freeze();
         Ok(())
     }
 

@@ -54,13 +54,23 @@ fn data_generate_check_then_reproduce_quick() {
     assert!(out.status.success(), "{}", text(&out));
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(res.join("results.json")).unwrap()).unwrap();
-    // 3 models × 8 w_task × 4 policies, and the two cross-data rows.
-    assert_eq!(json["rows"].as_array().unwrap().len(), 96);
-    assert_eq!(json["cross"].as_array().unwrap().len(), 2);
-    assert!(json["provenance"].as_str().unwrap().contains("synthetic"));
+    // 6 calibrated models × 8 w_task × 4 policies, and four cross-data
+    // rows, in the 3-seed protocol and in the many-seed run beside it.
+    let paper = &json["paper_protocol"];
+    let many = &json["many_seeds"];
+    for (run, seeds, spread) in [(paper, 3, "std"), (many, 5, "se")] {
+        assert_eq!(run["rows"].as_array().unwrap().len(), 192);
+        assert_eq!(run["cross"].as_array().unwrap().len(), 4);
+        assert_eq!(run["n_env_seeds"], seeds);
+        assert_eq!(run["spread"], spread);
+        assert!(run["provenance"].as_str().unwrap().contains("synthetic"));
+    }
+    // Every grid value of every method under every model: 6 × (1 + 1 + 3 + 3).
+    assert_eq!(json["frontier"].as_array().unwrap().len(), 6 * 8);
     let tables = std::fs::read_to_string(res.join("tables.md")).unwrap();
     assert!(tables.contains("Table I") && tables.contains("0.292 ± 0.113"));
-    for f in ["rollout.svg", "workload.svg"] {
+    assert!(tables.contains("5 seeds (mean ± standard error)"));
+    for f in ["rollout.svg", "workload.svg", "frontier.svg"] {
         assert!(Path::new(&res.join(f)).exists(), "{f}");
     }
     std::fs::remove_dir_all(&root).unwrap();
@@ -126,8 +136,19 @@ fn small_dataset(root: &Path) -> String {
     ds_s
 }
 
-/// Protocol settings with one seed, one w_task and the given methods.
+/// Protocol settings with one seed, one w_task, the bundled f2_sim and
+/// the given methods.
 fn small_settings(methods: &str, figures: &str) -> String {
+    settings_with_models(
+        r#"models = [{ name = "f2_sim", bundled = "f2_sim" }]"#,
+        methods,
+        figures,
+    )
+}
+
+/// [`small_settings`] with the given `models = ...` line (and any other
+/// top-level keys).
+fn settings_with_models(models: &str, methods: &str, figures: &str) -> String {
     format!(
         r#"
 seed = 0
@@ -136,6 +157,8 @@ n_policy_seeds = 1
 items_per_episode = 5
 w_tasks = [0.7]
 cross_w_task = 0.4
+
+{models}
 
 [session]
 n_att = 10
@@ -174,7 +197,7 @@ fn hil_run_and_hil_reproduce_score_an_episode_alike() {
             "rollout = \"LinUCB\"\nworkload = [\"LinUCB\"]",
         ),
     );
-    let row = res["rows"]
+    let row = res["paper_protocol"]["rows"]
         .as_array()
         .unwrap()
         .iter()
@@ -257,17 +280,87 @@ tune = {{ v = [0.1, 1.0] }}"#,
         small_settings(methods, "rollout = \"Thompson\"\nworkload = [\"Thompson\"]")
     );
     let (res, output) = reproduce_with(&root, &ds, &text_settings);
-    let rows: Vec<&serde_json::Value> = res["rows"]
+    let rows: Vec<&serde_json::Value> = res["paper_protocol"]["rows"]
         .as_array()
         .unwrap()
         .iter()
         .filter(|r| r["method"] == "Thompson")
         .collect();
-    assert_eq!(rows.len(), 3, "one row per workload model");
+    assert_eq!(
+        rows.len(),
+        1,
+        "one row per workload model (the settings name one)"
+    );
     for r in rows {
         assert_eq!(r["selected"]["name"], "v", "{r}");
         assert!(r["test"]["n_runs"].as_u64().unwrap() >= 1);
     }
     assert!(output.contains("Thompson"));
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// The workload models and the dataset come from the settings file: a
+/// model file under the name `f2_sim` changes the results, and a dataset
+/// path in the file (relative to it) is the one used.
+#[test]
+fn models_and_dataset_come_from_the_settings_file() {
+    let root = std::env::temp_dir().join(format!("hil-cli-inputs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    small_dataset(&root);
+    let methods = "[[methods]]\nlabel = \"AlwaysQuery\"\npolicy = { type = \"always_query\", alpha = 0.5, pretrain = true }";
+    let figures = "rollout = \"AlwaysQuery\"\nworkload = [\"AlwaysQuery\"]";
+    // The other end of the calibrated f2 model, as a model file.
+    std::fs::write(
+        root.join("other.json"),
+        hil_workload::bundled::json("f2_sim_steep").unwrap(),
+    )
+    .unwrap();
+    let run = |models: &str| {
+        let path = root.join("s.toml");
+        std::fs::write(&path, settings_with_models(models, methods, figures)).unwrap();
+        let out_dir = root.join("out");
+        let out = hil(&[
+            "reproduce",
+            "--quiet",
+            "--settings",
+            path.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        let json = std::fs::read_to_string(out_dir.join("results.json")).ok();
+        (
+            out,
+            json.map(|j| serde_json::from_str::<serde_json::Value>(&j).unwrap()),
+        )
+    };
+    let delta_wl = |v: &serde_json::Value| {
+        v["paper_protocol"]["rows"][0]["test"]["delta_wl"]["mean"]
+            .as_f64()
+            .unwrap()
+    };
+    let (out, bundled) =
+        run("dataset = \"ds\"\nmodels = [{ name = \"f2_sim\", bundled = \"f2_sim\" }]");
+    assert!(out.status.success(), "{}", text(&out));
+    let bundled = bundled.unwrap();
+    assert!(
+        bundled["paper_protocol"]["provenance"]
+            .as_str()
+            .unwrap()
+            .contains("synthetic")
+    );
+    let (out, file) =
+        run("dataset = \"ds\"\nmodels = [{ name = \"f2_sim\", file = \"other.json\" }]");
+    assert!(out.status.success(), "{}", text(&out));
+    assert_ne!(delta_wl(&bundled), delta_wl(&file.unwrap()));
+    // A dataset path that does not exist fails, naming it.
+    let (out, _) =
+        run("dataset = \"nowhere\"\nmodels = [{ name = \"f2_sim\", bundled = \"f2_sim\" }]");
+    assert!(!out.status.success());
+    assert!(text(&out).contains("nowhere"), "{}", text(&out));
+    // Exactly one source per model.
+    let (out, _) = run("dataset = \"ds\"\nmodels = [{ name = \"f2_sim\" }]");
+    assert!(!out.status.success());
+    assert!(text(&out).contains("models[0]"), "{}", text(&out));
     std::fs::remove_dir_all(&root).unwrap();
 }

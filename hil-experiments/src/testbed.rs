@@ -185,10 +185,12 @@ impl ProtocolSettings {
         }
     }
 
-    /// A fast smoke version: 3-point grids, 2 policy seeds.
+    /// A fast smoke version: 3-point grids, 2 policy seeds, a 5-seed run
+    /// beside the 3-seed protocol.
     pub fn quick() -> Self {
         let mut s = Self::paper();
         s.n_policy_seeds = 2;
+        s.many_seeds = 5;
         for m in &mut s.methods {
             for (name, values) in m.tune.iter_mut() {
                 *values = match name.as_str() {

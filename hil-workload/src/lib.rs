@@ -36,6 +36,7 @@ pub mod demo_counting;
 pub mod features;
 pub mod fit;
 pub mod models;
+pub mod seeds;
 pub mod select;
 pub mod stats;
 pub mod study;

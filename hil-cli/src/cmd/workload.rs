@@ -36,6 +36,22 @@ enum WorkloadCommand {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// The synthetic generator over many seeds: D1/D2 means and sds over
+    /// seeds beside the paper's (one generated study is one draw).
+    Seeds {
+        /// Number of generator seeds (0..count).
+        #[arg(long, default_value_t = 100)]
+        count: u64,
+        /// Generator settings as JSON (default: the calibrated one).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Recalibrate the level and spread parameters (mean,
+        /// population_shift, survey_sd, limited_survey_sd) until the D1/D2
+        /// means and sds over seeds are within 0.002 of the paper's, and
+        /// print the calibrated parameters.
+        #[arg(long)]
+        centre: bool,
+    },
     /// Print a study's headline figures (pairs, WL mean ± sd, Mann-Whitney D1 < D2).
     Summary {
         /// Study CSV.
@@ -159,18 +175,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             config,
             quiet,
         } => {
-            let cfg = match config {
-                Some(path) => {
-                    let text = hil_core::files::read_text(&path, hil_core::files::limits::CONFIG)?;
-                    serde_json::from_str::<SynthConfig>(&text).map_err(|e| HilError::Data {
-                        path: path.clone(),
-                        record: e.line(),
-                        field: "(json)".into(),
-                        why: e.to_string(),
-                    })?
-                }
-                None => SynthConfig::default(),
-            };
+            let cfg = synth_config(config.as_deref())?;
             let study = cfg.generate(seed)?;
             write(&out, &study.to_csv())?;
             if !quiet {
@@ -322,6 +327,32 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             }
             Ok(())
         }
+        WorkloadCommand::Seeds {
+            count,
+            config,
+            centre,
+        } => {
+            let cfg = synth_config(config.as_deref())?;
+            let t0 = Instant::now();
+            if centre {
+                let (c, spread) = hil_workload::seeds::centre(&cfg, 0..count, 0.002, 8)?;
+                print!("{}", spread.to_text());
+                let p = &c.params;
+                println!(
+                    "calibrated: mean = {}, population_shift = {}, survey_sd = {}, limited_survey_sd = {}",
+                    p.mean, p.population_shift, p.survey_sd, p.limited_survey_sd
+                );
+            } else {
+                print!(
+                    "{}",
+                    hil_workload::seeds::SeedSpread::over(&cfg, 0..count)?.to_text()
+                );
+            }
+            use std::io::Write as _;
+            let _ = std::io::stdout().flush();
+            eprintln!("{:.1} s. {SYNTHETIC}", t0.elapsed().as_secs_f64());
+            Ok(())
+        }
         WorkloadCommand::Calibrate { dir, check } => {
             print!("{}", hil_experiments::calibrate::report()?);
             let mut stale = Vec::new();
@@ -382,6 +413,20 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// The generator settings in `path` (JSON), or the calibrated default.
+fn synth_config(path: Option<&std::path::Path>) -> Result<SynthConfig> {
+    let Some(path) = path else {
+        return Ok(SynthConfig::default());
+    };
+    let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
+    serde_json::from_str::<SynthConfig>(&text).map_err(|e| HilError::Data {
+        path: path.to_path_buf(),
+        record: e.line(),
+        field: "(json)".into(),
+        why: e.to_string(),
+    })
 }
 
 /// Parses `t:response/difficulty/distraction,...`.

@@ -34,14 +34,15 @@ pub fn data_error(path: &Path, line: usize, field: &str, why: impl Into<String>)
 
 /// An RFC 4180 CSV text read record by record: the header, then each
 /// record with the 1-based line it starts on. Cells are trimmed of
-/// surrounding white space; blank lines are skipped; records may have any
+/// surrounding white space (a quoted field starts with its quote, right
+/// after the comma, as RFC 4180 has it); blank lines are skipped; records may have any
 /// number of cells (the caller compares them with the header, so it can
 /// say which line is short).
 ///
 /// ```
 /// use std::path::Path;
 /// use hil_core::textdata::CsvFile;
-/// let text = "name,note\n\"kiwi\",\"green, sour\"\n\npear , \"says \"\"hi\"\"\"\n";
+/// let text = "name,note\n\"kiwi\",\"green, sour\"\n\npear ,\"says \"\"hi\"\"\"\n";
 /// let mut csv = CsvFile::parse(text, Path::new("f.csv")).unwrap();
 /// assert_eq!(csv.header(), ["name", "note"]);
 /// let mut rec = hil_core::textdata::StringRecord::new();
@@ -56,9 +57,15 @@ pub fn data_error(path: &Path, line: usize, field: &str, why: impl Into<String>)
 /// ```
 pub struct CsvFile<'a> {
     path: PathBuf,
+    text: &'a str,
     reader: csv::Reader<&'a [u8]>,
     header_line: usize,
     header: Vec<String>,
+    /// Line numbers are counted here, not taken from the `csv` crate, whose
+    /// line count skips blank lines and `\r\n` pairs: `lines_before` line
+    /// breaks precede byte `scanned` of `text`.
+    scanned: usize,
+    lines_before: usize,
 }
 
 impl std::fmt::Debug for CsvFile<'_> {
@@ -84,7 +91,10 @@ impl<'a> CsvFile<'a> {
             .from_reader(text.as_bytes());
         let mut file = Self {
             path: path.to_path_buf(),
+            text,
             reader,
+            scanned: 0,
+            lines_before: 0,
             header_line: 1,
             header: Vec::new(),
         };
@@ -122,10 +132,13 @@ impl<'a> CsvFile<'a> {
     /// `None` at the end of the text.
     pub fn next_record(&mut self, record: &mut StringRecord) -> Result<Option<usize>> {
         loop {
-            let more = self.reader.read_record(record).map_err(|e| {
-                let line = e.position().map_or(0, |p| p.line() as usize);
-                data_error(&self.path, line, "record", format!("not valid CSV: {e}"))
-            })?;
+            let more = match self.reader.read_record(record) {
+                Ok(more) => more,
+                Err(e) => {
+                    let line = e.position().map_or(0, |p| self.line_at(p.byte()));
+                    return Err(self.error(line, "record", format!("not valid CSV: {e}")));
+                }
+            };
             if !more {
                 return Ok(None);
             }
@@ -133,15 +146,36 @@ impl<'a> CsvFile<'a> {
             if record.len() == 1 && record[0].is_empty() {
                 continue;
             }
-            let line = record.position().map_or(0, |p| p.line() as usize);
+            let line = record.position().map_or(0, |p| self.line_at(p.byte()));
             return Ok(Some(line));
         }
+    }
+
+    /// The 1-based line of the record the `csv` crate places at byte
+    /// `offset`: that offset may point at the line breaks before it, so
+    /// they are skipped. Offsets only grow, so counting is linear overall.
+    fn line_at(&mut self, offset: u64) -> usize {
+        let bytes = self.text.as_bytes();
+        let mut start = (offset as usize).min(bytes.len());
+        while start < bytes.len() && matches!(bytes[start], b'\r' | b'\n') {
+            start += 1;
+        }
+        if start < self.scanned {
+            return bytecount_newlines(&bytes[..start]) + 1;
+        }
+        self.lines_before += bytecount_newlines(&bytes[self.scanned..start]);
+        self.scanned = start;
+        self.lines_before + 1
     }
 
     /// An error about `field` at `line` of this file.
     pub fn error(&self, line: usize, field: &str, why: impl Into<String>) -> HilError {
         data_error(&self.path, line, field, why)
     }
+}
+
+fn bytecount_newlines(bytes: &[u8]) -> usize {
+    bytes.iter().filter(|&&b| b == b'\n').count()
 }
 
 /// One CSV record as RFC 4180 writes it (a field is quoted only when it
@@ -216,5 +250,61 @@ impl<'a> TextRecords<'a> {
     /// An error about `field` at `line` of this file.
     pub fn error(&self, line: usize, field: &str, why: impl Into<String>) -> HilError {
         data_error(&self.path, line, field, why)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lines(text: &str) -> Vec<(usize, Vec<String>)> {
+        let mut f = CsvFile::parse(text, Path::new("t.csv")).unwrap();
+        let mut out = vec![(f.header_line(), f.header().to_vec())];
+        let mut rec = StringRecord::new();
+        while let Some(line) = f.next_record(&mut rec).unwrap() {
+            out.push((line, rec.iter().map(str::to_string).collect()));
+        }
+        out
+    }
+
+    #[test]
+    fn line_numbers_count_blank_lines_crlf_and_quoted_line_breaks() {
+        let text = "\u{feff}\r\na,b\r\n\r\nx,y\r\n  \r\nz,\"multi\nline\"\n\n\nq ,\"r\"\n";
+        let got = lines(text);
+        let want: Vec<(usize, Vec<String>)> = [
+            (2, ["a", "b"]),
+            (4, ["x", "y"]),
+            (6, ["z", "multi\nline"]),
+            (10, ["q", "r"]),
+        ]
+        .into_iter()
+        .map(|(l, c)| (l, c.iter().map(|s| s.to_string()).collect()))
+        .collect();
+        assert_eq!(got, want);
+    }
+
+    #[test]
+    fn csv_line_round_trips_through_the_reader() {
+        let fields = ["plain", "a, b", "say \"hi\"", "two\nlines", ""];
+        let text = format!(
+            "{}{}",
+            csv_line(["c1", "c2", "c3", "c4", "c5"]),
+            csv_line(fields)
+        );
+        let got = lines(&text);
+        assert_eq!(got[1].0, 2);
+        assert_eq!(got[1].1, fields);
+    }
+
+    #[test]
+    fn empty_text_is_a_header_error_at_line_1() {
+        for text in ["", "\n\n", "  \r\n"] {
+            match CsvFile::parse(text, Path::new("t.csv")).unwrap_err() {
+                HilError::Data { record, field, .. } => {
+                    assert_eq!((record, field.as_str()), (1, "header"))
+                }
+                other => panic!("{other:?}"),
+            }
+        }
     }
 }

@@ -214,7 +214,11 @@ impl Dataset {
         Self::build_if_any_with_grid(study, id, TimeGrid::default())
     }
 
-    fn build_if_any_with_grid(study: &Study, id: DatasetId, grid: TimeGrid) -> Result<Option<Self>> {
+    fn build_if_any_with_grid(
+        study: &Study,
+        id: DatasetId,
+        grid: TimeGrid,
+    ) -> Result<Option<Self>> {
         let mut participants: Vec<String> = Vec::new();
         let mut p_index: BTreeMap<&str, usize> = BTreeMap::new();
         // participant -> (sum, count) of baseline workloads

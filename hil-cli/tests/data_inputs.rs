@@ -140,7 +140,14 @@ fn npy_array_that_is_not_a_file_is_refused() {
     assert!(out.status.success(), "{}", stderr(&out));
     for p in special_files(&dir) {
         for field in ["contexts", "success", "settings"] {
-            let ds = dataset_with(&dir.join(format!("{field}-{}", p.file_name().unwrap().to_string_lossy())), field, &p);
+            let ds = dataset_with(
+                &dir.join(format!(
+                    "{field}-{}",
+                    p.file_name().unwrap().to_string_lossy()
+                )),
+                field,
+                &p,
+            );
             let out = hil(&["data", "check", ds.to_str().unwrap()]);
             assert_refused(&out, &p);
         }
@@ -177,7 +184,10 @@ fn workload_summary_reports_a_dataset_it_cannot_build() {
     let out = hil(&["workload", "summary", "--data", good.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
     let o = String::from_utf8_lossy(&out.stdout);
-    assert!(o.contains("D1: 1 pairs") && o.contains("D12: 1 pairs") && !o.contains("D2:"), "{o}");
+    assert!(
+        o.contains("D1: 1 pairs") && o.contains("D12: 1 pairs") && !o.contains("D2:"),
+        "{o}"
+    );
 
     // A study of baseline surveys only has nothing to summarise: an error.
     let none = dir.join("baseline_only.csv");

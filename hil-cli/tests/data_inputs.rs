@@ -175,6 +175,7 @@ fn workload_summary_reports_a_dataset_it_cannot_build() {
         e.contains(&format!("{}:4: field `participant`", bad.display())) && e.contains("`p2`"),
         "{e}"
     );
+    assert!(out.stdout.is_empty(), "no partial summary");
 
     // Without p2 the study is fine; its D2 is empty (no such participants),
     // which is not an error: the summary shows D1 and D12.

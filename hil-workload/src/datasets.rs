@@ -111,11 +111,29 @@ impl DatasetId {
 /// assert_eq!(first_two.len(), 2);
 /// assert_eq!(first_two.records().last().unwrap().t, 5);
 /// assert_eq!(first_two.to_history().len(), 2);
+/// // Only the prefix counts: the first query alone, from either history.
+/// let mut one = QueryHistory::new();
+/// one.push(2, QueryKind::default()).unwrap();
+/// assert_eq!(HistoryPrefix::new(all, 1), HistoryPrefix::new(Arc::new(one), 1));
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone)]
 pub struct HistoryPrefix {
     all: Arc<QueryHistory>,
     len: usize,
+}
+
+// Equality and debug output are those of the prefix's queries: what the
+// rest of the shared history holds is not part of the value.
+impl PartialEq for HistoryPrefix {
+    fn eq(&self, other: &Self) -> bool {
+        self.records() == other.records()
+    }
+}
+
+impl std::fmt::Debug for HistoryPrefix {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.records()).finish()
+    }
 }
 
 impl HistoryPrefix {

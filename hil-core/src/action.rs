@@ -1,5 +1,7 @@
 //! Robot actions (arms) and the named action space of a task.
 
+use std::collections::HashSet;
+
 use serde::{Deserialize, Serialize};
 
 use crate::error::{HilError, Result};
@@ -30,6 +32,9 @@ impl std::fmt::Display for ArmId {
 /// assert_eq!(space.len(), 3);
 /// assert_eq!(space.name(ArmId(2)).unwrap(), "push");
 /// assert_eq!(space.find("grasp_side"), Some(ArmId(1)));
+/// // Names are unique and non-empty.
+/// assert!(ActionSpace::new(["push", "grasp_top", "push"]).is_err());
+/// assert!(ActionSpace::new(["push", " "]).is_err());
 /// ```
 ///
 /// Tasks define their own spaces (the feeding task's six skewering actions
@@ -41,11 +46,15 @@ pub struct ActionSpace {
 
 impl ActionSpace {
     /// Builds an action space from unique, non-empty names.
+    ///
+    /// Linear in the number of names (duplicates are found with a hash set),
+    /// so a manifest with hundreds of thousands of actions is checked quickly.
     pub fn new<S: Into<String>>(names: impl IntoIterator<Item = S>) -> Result<Self> {
         let names: Vec<String> = names.into_iter().map(Into::into).collect();
         if names.is_empty() {
             return Err(HilError::invalid_input("action space", "it has no actions"));
         }
+        let mut seen: HashSet<&str> = HashSet::with_capacity(names.len());
         for (i, n) in names.iter().enumerate() {
             if n.trim().is_empty() {
                 return Err(HilError::invalid_input(
@@ -53,7 +62,7 @@ impl ActionSpace {
                     "it is empty",
                 ));
             }
-            if names[..i].contains(n) {
+            if !seen.insert(n) {
                 return Err(HilError::invalid_input(
                     format!("action name #{i}"),
                     format!("`{n}` appears twice"),

@@ -30,6 +30,7 @@
 //! [0, 1], setting indices exist and outcomes are 0 or 1; every error names
 //! the file, the record (1-based image row) and the field.
 
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -186,11 +187,13 @@ impl FoodDataset {
         if self.foods.is_empty() {
             return Err(data_err(path, 0, "foods", "the dataset has no foods"));
         }
+        // A hash set keeps the duplicate check linear in the number of foods.
+        let mut names: HashSet<&str> = HashSet::with_capacity(self.foods.len());
         for (k, f) in self.foods.iter().enumerate() {
             if f.name.trim().is_empty() {
                 return Err(data_err(path, k + 1, "foods.name", "empty food name"));
             }
-            if self.foods[..k].iter().any(|g| g.name == f.name) {
+            if !names.insert(&f.name) {
                 return Err(data_err(
                     path,
                     k + 1,

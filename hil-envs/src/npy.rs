@@ -6,6 +6,14 @@
 //! `u1` and `b1` (all returned as `f64`); C order only. Files are always
 //! written as version 1.0, little-endian `f8`, C order.
 //!
+//! Limits: a file holds at most [`hil_core::files::limits::ARRAY`] bytes
+//! (a FIFO, device or directory is refused before anything is read) and an
+//! array at most [`MAX_ELEMENTS`] elements, so that a small element type
+//! cannot expand past 1 GiB as `f64`. The declared shape must match the
+//! data exactly; nothing is allocated for the data before that is checked.
+//! Every error is a [`HilError::Data`] naming the file and the header field
+//! (`magic`, `version`, `header`, `descr`, `fortran_order`, `shape`, `data`).
+//!
 //! ```
 //! use hil_envs::npy::{NpyArray, read_npy_bytes, write_npy_bytes};
 //! let a = NpyArray::new(vec![2, 3], vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]).unwrap();
@@ -19,6 +27,9 @@ use std::path::Path;
 use hil_core::{HilError, Result};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
+
+/// The most elements an array may have: 2^27, i.e. 1 GiB as `f64`.
+pub const MAX_ELEMENTS: usize = 1 << 27;
 
 /// An n-dimensional array of `f64` in C (row-major) order.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,6 +54,11 @@ impl NpyArray {
     }
 
     /// Row `i` of a 2-d array (or the `i`-th sub-array along axis 0).
+    ///
+    /// # Panics
+    ///
+    /// If the array has no axis or `i` is not below `shape[0]` (callers
+    /// check the shape first, as the dataset loader does).
     pub fn row(&self, i: usize) -> &[f64] {
         let stride: usize = self.shape[1..].iter().product();
         &self.data[i * stride..(i + 1) * stride]
@@ -173,7 +189,14 @@ pub fn read_npy_bytes(bytes: &[u8], path: &Path) -> Result<NpyArray> {
     let n = shape
         .iter()
         .try_fold(1usize, |acc, &d| acc.checked_mul(d))
-        .ok_or_else(|| bad(path, "shape", "shape overflows"))?;
+        .filter(|&n| n <= MAX_ELEMENTS)
+        .ok_or_else(|| {
+            bad(
+                path,
+                "shape",
+                format!("shape {shape:?} has more than {MAX_ELEMENTS} elements"),
+            )
+        })?;
     let body = &bytes[end..];
     let need = n
         .checked_mul(dtype.size())
@@ -303,6 +326,25 @@ mod tests {
         let pos = c16.windows(3).position(|w| w == b"<f4").unwrap();
         c16[pos..pos + 3].copy_from_slice(b"<c8");
         assert!(err(&c16).contains("descr"));
+    }
+
+    #[test]
+    fn huge_shapes_are_refused_before_allocating() {
+        for shape in [
+            "(134217729,)",
+            "(99999999999, 99999999999)",
+            "(18446744073709551615, 2)",
+        ] {
+            let mut b = numpy_f4();
+            let at = b.windows(6).position(|w| w == b"(1, 2)").unwrap();
+            b.splice(at..at + 6, shape.bytes());
+            match read_npy_bytes(&b, p()).unwrap_err() {
+                HilError::Data { path, field, .. } => {
+                    assert_eq!((path.as_path(), field.as_str()), (p(), "shape"), "{shape}")
+                }
+                other => panic!("{other:?}"),
+            }
+        }
     }
 
     #[test]

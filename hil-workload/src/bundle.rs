@@ -31,18 +31,23 @@ pub struct StudySummary {
 }
 
 impl StudySummary {
-    /// Summarises `study` (datasets without pairs are skipped).
+    /// Summarises `study`. A dataset whose population has no query rows is
+    /// left out; any other fault (e.g. a participant without a baseline
+    /// survey) is an error, as is a study without any query row.
     pub fn of(study: &Study) -> Result<Self> {
         let mut datasets = Vec::new();
         let mut targets = Vec::new();
         for id in DatasetId::ALL {
-            if let Ok(d) = Dataset::build(study, id) {
+            if let Some(d) = Dataset::build_if_any(study, id)? {
                 let t = d.targets();
                 let (m, s) = mean_std(&t);
                 let wl0 = d.pairs.iter().map(|p| p.wl0).sum::<f64>() / d.pairs.len() as f64;
                 datasets.push((id, t.len(), m, s, wl0));
                 targets.push((id, t));
             }
+        }
+        if datasets.is_empty() {
+            return Err(crate::datasets::no_query_rows(study, DatasetId::D12));
         }
         let get = |id| targets.iter().find(|(d, _)| *d == id).map(|(_, t)| t);
         let d1_less_than_d2 = match (get(DatasetId::D1), get(DatasetId::D2)) {

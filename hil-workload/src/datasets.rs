@@ -21,8 +21,9 @@
 //! participant with query rows but no baseline survey is an error.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
-use hil_core::{HilError, QueryHistory, Result, TimeGrid, Timestep};
+use hil_core::{HilError, QueryHistory, QueryRecord, Result, TimeGrid, Timestep};
 use serde::{Deserialize, Serialize};
 
 use crate::study::{Population, Study, StudyRecord};
@@ -90,6 +91,82 @@ impl DatasetId {
     }
 }
 
+/// The queries of one condition up to and including one of them: a prefix
+/// of the condition's history, which every pair of the condition shares.
+///
+/// Sharing keeps a dataset linear in the study's rows: a condition with n
+/// queries holds its history once (n records) instead of once per pair
+/// (n²/2 records; 3 GB for a 20,000-query condition).
+///
+/// ```
+/// use std::sync::Arc;
+/// use hil_core::{QueryHistory, QueryKind};
+/// use hil_workload::datasets::HistoryPrefix;
+/// let mut all = QueryHistory::new();
+/// for t in [2, 5, 9] {
+///     all.push(t, QueryKind::default()).unwrap();
+/// }
+/// let all = Arc::new(all);
+/// let first_two = HistoryPrefix::new(Arc::clone(&all), 2);
+/// assert_eq!(first_two.len(), 2);
+/// assert_eq!(first_two.records().last().unwrap().t, 5);
+/// assert_eq!(first_two.to_history().len(), 2);
+/// // Only the prefix counts: the first query alone, from either history.
+/// let mut one = QueryHistory::new();
+/// one.push(2, QueryKind::default()).unwrap();
+/// assert_eq!(HistoryPrefix::new(all, 1), HistoryPrefix::new(Arc::new(one), 1));
+/// ```
+#[derive(Clone)]
+pub struct HistoryPrefix {
+    all: Arc<QueryHistory>,
+    len: usize,
+}
+
+// Equality and debug output are those of the prefix's queries: what the
+// rest of the shared history holds is not part of the value.
+impl PartialEq for HistoryPrefix {
+    fn eq(&self, other: &Self) -> bool {
+        self.records() == other.records()
+    }
+}
+
+impl std::fmt::Debug for HistoryPrefix {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.records()).finish()
+    }
+}
+
+impl HistoryPrefix {
+    /// The first `len` queries of `all` (at most all of them).
+    pub fn new(all: Arc<QueryHistory>, len: usize) -> Self {
+        let len = len.min(all.len());
+        Self { all, len }
+    }
+
+    /// The queries of the prefix, oldest first.
+    pub fn records(&self) -> &[QueryRecord] {
+        &self.all.records()[..self.len]
+    }
+
+    /// Number of queries in the prefix.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True if the prefix holds no query.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The prefix as an owned [`QueryHistory`], for [`hil_core::WorkloadModel`]
+    /// calls. It copies the prefix (O(len)): call it per prediction, do not
+    /// store the result.
+    pub fn to_history(&self) -> QueryHistory {
+        QueryHistory::from_records(self.records().to_vec())
+            .expect("a prefix of a valid history is valid")
+    }
+}
+
 /// One (query history, workload) training pair.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrainingPair {
@@ -99,8 +176,9 @@ pub struct TrainingPair {
     pub wl0: f64,
     /// Timestep of the query (where the workload was measured).
     pub t: Timestep,
-    /// The condition's queries up to and including this one.
-    pub history: QueryHistory,
+    /// The condition's queries up to and including this one (shared with
+    /// the condition's other pairs).
+    pub history: HistoryPrefix,
     /// Measured workload after the query.
     pub target: f64,
 }
@@ -131,6 +209,34 @@ impl Dataset {
 
     /// Builds dataset `id` on a custom time grid.
     pub fn build_with_grid(study: &Study, id: DatasetId, grid: TimeGrid) -> Result<Self> {
+        Self::build_if_any_with_grid(study, id, grid)?.ok_or_else(|| no_query_rows(study, id))
+    }
+
+    /// Builds dataset `id`, or `None` if the study has no query rows of its
+    /// population (e.g. D2 of a study with only D1 participants). Every
+    /// other fault in the data is an error, as with [`Dataset::build`].
+    ///
+    /// ```
+    /// use hil_workload::{datasets::{Dataset, DatasetId}, study::Study};
+    /// let header = "participant,population,condition,query_time_s,difficulty,response_type,distraction,interval_min,mental,temporal,performance,effort,frustration,survey_time_s";
+    /// let base = "p1,no_limitation,base,330,,,easy,,2,1,4,2,1,";
+    /// let query = "p1,no_limitation,c1,60,easy,mcq,none,1,3,2,4,3,1,";
+    /// let study = Study::parse(&format!("{header}\n{base}\n{query}\n"), "s.csv".as_ref()).unwrap();
+    /// assert!(Dataset::build_if_any(&study, DatasetId::D1).unwrap().is_some());
+    /// assert!(Dataset::build_if_any(&study, DatasetId::D2).unwrap().is_none());
+    /// // Without the baseline survey WL_0 is unknown: an error, not `None`.
+    /// let study = Study::parse(&format!("{header}\n{query}\n"), "s.csv".as_ref()).unwrap();
+    /// assert!(Dataset::build_if_any(&study, DatasetId::D1).is_err());
+    /// ```
+    pub fn build_if_any(study: &Study, id: DatasetId) -> Result<Option<Self>> {
+        Self::build_if_any_with_grid(study, id, TimeGrid::default())
+    }
+
+    fn build_if_any_with_grid(
+        study: &Study,
+        id: DatasetId,
+        grid: TimeGrid,
+    ) -> Result<Option<Self>> {
         let mut participants: Vec<String> = Vec::new();
         let mut p_index: BTreeMap<&str, usize> = BTreeMap::new();
         // participant -> (sum, count) of baseline workloads
@@ -177,40 +283,50 @@ impl Dataset {
             let wl0 = sum / n as f64;
             let mut sorted: Vec<&StudyRecord> = rows.clone();
             sorted.sort_by(|a, b| a.query_time_s.total_cmp(&b.query_time_s));
+            // The condition's history is built once; its pairs refer to
+            // prefixes of it.
             let mut history = QueryHistory::new();
             let mut survey_offset = 0.0;
-            for r in sorted {
+            for r in &sorted {
                 let t = grid.step_of(r.query_time_s + survey_offset);
                 let kind = r.kind().expect("query rows only");
                 history.push(t, kind)?;
+                survey_offset += id.survey_seconds(r);
+            }
+            let history = Arc::new(history);
+            for (i, (r, q)) in sorted.iter().zip(history.records()).enumerate() {
                 pairs.push(TrainingPair {
                     participant: p,
                     wl0,
-                    t,
-                    history: history.clone(),
+                    t: q.t,
+                    history: HistoryPrefix::new(Arc::clone(&history), i + 1),
                     target: r.tlx.workload(),
                 });
-                survey_offset += id.survey_seconds(r);
             }
         }
         if pairs.is_empty() {
-            return Err(HilError::Data {
-                path: study.source().to_path_buf(),
-                record: 1,
-                field: "population".into(),
-                why: format!("dataset {} has no query rows", id.as_str().to_uppercase()),
-            });
+            return Ok(None);
         }
-        Ok(Self {
+        Ok(Some(Self {
             id,
             participants,
             pairs,
-        })
+        }))
     }
 
     /// Workload scores of all surveys with a query (the targets).
     pub fn targets(&self) -> Vec<f64> {
         self.pairs.iter().map(|p| p.target).collect()
+    }
+}
+
+/// The error for a dataset without query rows.
+pub(crate) fn no_query_rows(study: &Study, id: DatasetId) -> HilError {
+    HilError::Data {
+        path: study.source().to_path_buf(),
+        record: 1,
+        field: "population".into(),
+        why: format!("dataset {} has no query rows", id.as_str().to_uppercase()),
     }
 }
 

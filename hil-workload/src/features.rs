@@ -76,10 +76,19 @@ pub struct SparseRow {
 
 impl SparseRow {
     /// Encodes `pair` for history length `h`.
+    ///
+    /// Costs O(h + log n) for a pair whose history holds n queries: only
+    /// the queries of the last `h` timesteps are read.
     pub fn of_pair(pair: &TrainingPair, h: usize) -> Self {
+        let records = pair.history.records();
+        // The history is in time order, so the queries inside the window are
+        // a tail of it; `lag_features` then reads them as any model would.
+        let start = records.partition_point(|r| pair.t.saturating_sub(r.t) >= h as u64);
+        let window = QueryHistory::from_records(records[start..].to_vec())
+            .expect("a slice of a valid history is valid");
         let mut entries = vec![(0, pair.wl0), (1, 1.0)];
         entries.extend(
-            lag_features(&pair.history, pair.t, h)
+            lag_features(&window, pair.t, h)
                 .into_iter()
                 .map(|(c, v)| (c + LEAD_COLUMNS, v)),
         );

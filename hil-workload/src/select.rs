@@ -284,7 +284,10 @@ impl<'a> Problem<'a> {
         let (mut s, mut n) = (0.0, 0usize);
         for i in self.rows_of(parts) {
             let p = self.pairs[i];
-            let e = spec.as_model().predict(p.wl0, &p.history, p.t)? - p.target;
+            let e = spec
+                .as_model()
+                .predict(p.wl0, &p.history.to_history(), p.t)?
+                - p.target;
             s += e * e;
             n += 1;
         }

@@ -1,6 +1,14 @@
 //! The study-data format: one CSV row per TLX survey, with a validating
 //! loader whose errors name the file, line and column.
 //!
+//! The file is RFC 4180 CSV (read with the `csv` crate through
+//! [`hil_core::textdata::CsvFile`]): any field may be quoted, as spreadsheet
+//! programs write them, and a quoted field may hold commas. Blank lines and
+//! white space around fields are ignored; a UTF-8 byte-order mark is
+//! allowed. Files are read through [`hil_core::files`] and may hold at most
+//! [`hil_core::files::limits::STUDY`] bytes. Memory and time are linear in
+//! the rows.
+//!
 //! Columns (a header row names them; any order; every column required, no
 //! extras, no duplicates):
 //!
@@ -35,9 +43,9 @@
 //! ```
 
 use std::collections::{HashMap, HashSet};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use hil_core::textdata::{CsvFile, StringRecord, csv_line, data_error};
 use hil_core::{Difficulty, Distraction, HilError, QueryKind, ResponseType, Result};
 use serde::{Deserialize, Serialize};
 
@@ -148,12 +156,7 @@ fn data_err(
     field: impl Into<String>,
     why: impl Into<String>,
 ) -> HilError {
-    HilError::Data {
-        path: path.to_path_buf(),
-        record: line,
-        field: field.into(),
-        why: why.into(),
-    }
+    data_error(path, line, &field.into(), why)
 }
 
 impl Study {
@@ -175,27 +178,18 @@ impl Study {
     }
 
     /// Parses and validates study CSV text; `path` names it in errors.
+    ///
+    /// The text is RFC 4180 CSV: any field may be quoted (as spreadsheet
+    /// programs write them), surrounding white space is ignored. Rows are
+    /// parsed one at a time, so memory grows with the records, not more.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .filter(|(_, l)| !l.trim().is_empty());
-        let Some((header_idx, header)) = lines.next() else {
-            return Err(data_err(
-                path,
-                1,
-                "header",
-                "the file is empty: expected a header row",
-            ));
-        };
-        let header_line = header_idx + 1;
+        let mut csv = CsvFile::parse(text, path)?;
+        let header_line = csv.header_line();
+        let names: Vec<String> = csv.header().to_vec();
         let mut index: HashMap<&str, usize> = HashMap::new();
-        let names: Vec<&str> = header
-            .split(',')
-            .map(|c| c.trim().trim_start_matches('\u{feff}'))
-            .collect();
         for (i, name) in names.iter().enumerate() {
-            if !COLUMNS.contains(name) {
+            let name = name.as_str();
+            if !COLUMNS.contains(&name) {
                 return Err(data_err(
                     path,
                     header_line,
@@ -220,9 +214,9 @@ impl Study {
         }
         let col = |name: &str| index[name];
         let mut records = Vec::new();
-        for (idx, raw) in lines {
-            let line = idx + 1;
-            let cells: Vec<&str> = raw.split(',').map(str::trim).collect();
+        let mut row = StringRecord::new();
+        while let Some(line) = csv.next_record(&mut row)? {
+            let cells: Vec<&str> = row.iter().collect();
             if cells.len() != names.len() {
                 return Err(data_err(
                     path,
@@ -401,21 +395,18 @@ impl Study {
         let mut seen: HashSet<(&str, &str, u64)> = HashSet::new();
         for (i, r) in self.records.iter().enumerate() {
             let line = if r.line > 0 { r.line } else { i + 2 };
-            if r.participant.is_empty() || r.participant.contains(',') {
-                return Err(data_err(
-                    path,
-                    line,
-                    "participant",
-                    "must be non-empty and contain no comma",
-                ));
-            }
-            if r.condition.is_empty() || r.condition.contains(',') {
-                return Err(data_err(
-                    path,
-                    line,
-                    "condition",
-                    "must be non-empty and contain no comma",
-                ));
+            // Any text is an id (the CSV quotes what needs quoting), but
+            // the reader trims cells, so surrounding white space would not
+            // survive writing and reading back.
+            for (field, id) in [("participant", &r.participant), ("condition", &r.condition)] {
+                if id.is_empty() || id.trim() != id {
+                    return Err(data_err(
+                        path,
+                        line,
+                        field,
+                        "must be non-empty, without surrounding white space",
+                    ));
+                }
             }
             if !(r.query_time_s.is_finite() && r.query_time_s >= 0.0) {
                 return Err(data_err(
@@ -506,10 +497,10 @@ impl Study {
         &self.source
     }
 
-    /// Renders the study as CSV in the documented format.
+    /// Renders the study as CSV in the documented format (RFC 4180: a
+    /// field is quoted only if it needs to be).
     pub fn to_csv(&self) -> String {
-        let mut out = COLUMNS.join(",");
-        out.push('\n');
+        let mut out = csv_line(COLUMNS);
         for r in &self.records {
             let (d, rt, iv) = match r.query {
                 Some(q) => (
@@ -519,21 +510,22 @@ impl Study {
                 ),
                 None => ("", "", String::new()),
             };
-            let _ = writeln!(
-                out,
-                "{},{},{},{},{d},{rt},{},{iv},{},{},{},{},{},{}",
-                r.participant,
+            out.push_str(&csv_line([
+                r.participant.as_str(),
                 r.population.as_str(),
-                r.condition,
-                r.query_time_s,
+                r.condition.as_str(),
+                &r.query_time_s.to_string(),
+                d,
+                rt,
                 r.distraction.as_str(),
-                r.tlx.mental,
-                r.tlx.temporal,
-                r.tlx.performance,
-                r.tlx.effort,
-                r.tlx.frustration,
-                r.survey_time_s.map(|s| s.to_string()).unwrap_or_default(),
-            );
+                &iv,
+                &r.tlx.mental.to_string(),
+                &r.tlx.temporal.to_string(),
+                &r.tlx.performance.to_string(),
+                &r.tlx.effort.to_string(),
+                &r.tlx.frustration.to_string(),
+                &r.survey_time_s.map(|s| s.to_string()).unwrap_or_default(),
+            ]));
         }
         out
     }
@@ -565,6 +557,64 @@ mod tests {
         assert_eq!(s.records().len(), 2);
         let again = Study::parse(&s.to_csv(), Path::new("s.csv")).unwrap();
         assert_eq!(again.records(), s.records());
+    }
+
+    #[test]
+    fn a_spreadsheet_export_reads_like_the_plain_file() {
+        let plain = "p1,mobility_limitation,c1,60,hard,open_ended,easy,2,1,2,3,4,5,30.5\np1,mobility_limitation,b,330,,,hard,,1,1,1,1,1,\n";
+        // Every field quoted, CRLF line ends, a byte-order mark and a blank line.
+        let quoted: String = std::iter::once(HEADER)
+            .chain(plain.lines())
+            .map(|l| {
+                let cells: Vec<String> = l.split(',').map(|c| format!("\"{c}\"")).collect();
+                cells.join(",") + "\r\n\r\n"
+            })
+            .collect();
+        let a = parse(plain).unwrap();
+        let b = Study::parse(&format!("\u{feff}{quoted}"), Path::new("s.csv")).unwrap();
+        let strip = |s: &Study| -> Vec<StudyRecord> {
+            s.records()
+                .iter()
+                .map(|r| StudyRecord {
+                    line: 0,
+                    ..r.clone()
+                })
+                .collect()
+        };
+        assert_eq!(strip(&a), strip(&b));
+        // Lines are counted in the file, blank ones included.
+        assert_eq!(b.records()[1].line, 5);
+    }
+
+    #[test]
+    fn ids_with_commas_and_quotes_round_trip() {
+        let s = parse(
+            "\"Smith, J.\",no_limitation,\"the \"\"easy\"\" one\",60,easy,mcq,none,1,1,2,3,4,5,\n",
+        )
+        .unwrap();
+        assert_eq!(s.records()[0].participant, "Smith, J.");
+        assert_eq!(s.records()[0].condition, "the \"easy\" one");
+        let again = Study::parse(&s.to_csv(), Path::new("s.csv")).unwrap();
+        assert_eq!(again.records(), s.records());
+    }
+
+    #[test]
+    fn errors_give_the_line_a_record_starts_on() {
+        // A quoted line break in a condition id: the next record is on line 4.
+        let e = parse("p1,no_limitation,\"c\n1\",60,easy,mcq,none,1,1,2,3,4,5,\np1,no_limitation,c2,60,easy,mcq,none,1,1,2,3,4,9,\n").unwrap_err();
+        match e {
+            HilError::Data { record, field, .. } => {
+                assert_eq!(record, 4);
+                assert_eq!(field, "column 13 (`frustration`)");
+            }
+            other => panic!("{other:?}"),
+        }
+        match parse("p1,no_limitation,c1,60,easy,mcq,none,1,1,2,3\n").unwrap_err() {
+            HilError::Data { record, field, .. } => {
+                assert_eq!((record, field.as_str()), (2, "row"))
+            }
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

@@ -64,8 +64,9 @@ fn json_round_trip_gives_bit_identical_predictions() {
         let back = FittedModel::from_json(&m.to_json(), "x.json".as_ref()).unwrap();
         assert_eq!(&back, m);
         for p in &d.pairs {
-            let a = m.predict(p.wl0, &p.history, p.t).unwrap();
-            let b = back.predict(p.wl0, &p.history, p.t).unwrap();
+            let h = p.history.to_history();
+            let a = m.predict(p.wl0, &h, p.t).unwrap();
+            let b = back.predict(p.wl0, &h, p.t).unwrap();
             assert_eq!(a.to_bits(), b.to_bits(), "{}", m.name);
         }
     }
@@ -112,7 +113,7 @@ fn sparse_design_path_matches_model_predictions() {
                 let fast = SparseRow::of_pair(p, g.history)
                     .dot_prefix(&w)
                     .clamp(0.0, 1.0);
-                let slow = g.predict(p.wl0, &p.history, p.t).unwrap();
+                let slow = g.predict(p.wl0, &p.history.to_history(), p.t).unwrap();
                 assert!((fast - slow).abs() < 1e-12, "{}: {fast} vs {slow}", m.name);
             }
         }

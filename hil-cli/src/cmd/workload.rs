@@ -191,8 +191,11 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
         }
         WorkloadCommand::Summary { data } => {
             let study = Study::load(&data)?;
+            // Summarised before anything is printed: a study that cannot be
+            // summarised prints only its error.
+            let summary = StudySummary::of(&study)?;
             println!("{}: {} surveys", data.display(), study.records().len());
-            print!("{}", StudySummary::of(&study)?.to_text());
+            print!("{}", summary.to_text());
             Ok(())
         }
         WorkloadCommand::Select {

@@ -16,6 +16,7 @@
 
 pub mod cdylib;
 pub mod fixtures;
+pub mod mutate;
 pub mod strategies;
 
 mod channel;

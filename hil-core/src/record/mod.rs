@@ -3,17 +3,36 @@
 //!
 //! # Format
 //!
-//! One JSON object per line, tagged by its `record` field (see [`Record`]):
+//! One JSON object per line, tagged by its `record` field (see [`Record`]).
+//! Every line starts with a `chain` field, the SHA-256 of the previous
+//! line's `chain` and the line's own content ([`chain`]), which makes the
+//! log tamper-evident.
 //!
 //! | record | when | fields |
 //! |---|---|---|
-//! | `header` | first line | `format` (`hil-interaction-record`), `version` (2), `seed`, `episodes`, `config_path`, `base_dir`, `config` (the experiment TOML, verbatim) |
+//! | `header` | first line | `format` (`hil-interaction-record`), `version` (3), `seed`, `episodes`, `config_path`, `base_dir`, `config` (the experiment TOML, verbatim), `config_digest` (its SHA-256) |
 //! | `episode_start` | episode begins | `episode`, `seed` |
 //! | `step` | decided, **fsync'ed before the robot acts** | `episode`, `step`: `t`, `item_index`, `item_label`, `attempt`, `context`, `decision` (`act` / `query` with its `kind` = response type, difficulty, distraction, and `fallback` / `follow_expert`), `diagnostics`, `response` (answer, expert arm, response time; a `timed_out` answer means the policy acted on its own), `arm`, `wl_t` (WL_t = f(WL_0, Q_t) at this step) |
 //! | `outcome` | after execution, fsync'ed | `episode`, `t`, `outcome` (`success`, `success_probability`) |
 //! | `episode_end` | episode ends | `episode`, `metrics` |
 //! | `checkpoint` | after `episode_end`, if the policy can save its state | `episode`, `policy` (its [`crate::Policy::save`]) |
 //! | `resumed` | where a resumed session started appending | `lines`, `truncated_bytes`, `from_checkpoint` |
+//!
+//! # One writer, and tamper evidence
+//!
+//! A [`RecordLog`] holds an exclusive lock on its file for as long as it
+//! lives ([`lock`]): a second writer, such as a second `hil run --resume` or
+//! a resume while the original run still writes, is refused with an error
+//! naming the process, host and start time of the holder.
+//!
+//! [`RecordLog::open`] reads at most [`crate::files::limits::LOG`] bytes of
+//! a regular file and verifies every complete line before anything is
+//! resumed: its record, its place in the hash chain, and the header's
+//! `config_digest`. A flipped bit anywhere (an `episode_end` before the
+//! last checkpoint included), an edited checkpoint, removed or reordered
+//! lines, a header spliced from another log, or an edited config are
+//! refused with the line at fault. The chain has no key: it catches
+//! corruption and edits, not a forger who recomputes it.
 //!
 //! # Resuming
 //!
@@ -57,7 +76,9 @@
 //! # std::fs::remove_dir_all(&dir).unwrap();
 //! ```
 
+pub mod chain;
 pub mod format;
+pub mod lock;
 pub mod log;
 pub mod recorder;
 mod replay;

@@ -43,10 +43,13 @@ struct JsonlEvents {
 
 impl SessionObserver for JsonlEvents {
     fn on_step(&mut self, event: &StepEvent) -> hil_core::Result<()> {
-        serde_json::to_writer(&mut self.out, event)
-            .map_err(|e| HilError::serde("step event", e))?;
+        // Serialised apart from writing, so that a failing file (a full
+        // disk, /dev/full) is reported as an I/O error naming it.
+        let mut line =
+            serde_json::to_vec(event).map_err(|e| HilError::serde("step event", e))?;
+        line.push(b'\n');
         self.out
-            .write_all(b"\n")
+            .write_all(&line)
             .map_err(|e| HilError::io("writing", &self.path, e))
     }
 }
@@ -61,6 +64,32 @@ enum Start {
 }
 
 pub fn run(args: RunArgs) -> hil_core::Result<()> {
+    let result = run_session(&args);
+    // Every component has been dropped by now: a plugin object whose
+    // destructor panicked is reported (PLUGINS.md), not passed over.
+    let mut drop_panics = hil_core::plugin::take_destructor_panics().into_iter();
+    let summary = match (result, drop_panics.next()) {
+        (Ok(summary), None) => summary,
+        (Ok(summary), Some(first)) => {
+            print_summary(&summary, args.json, args.quiet)?;
+            for e in drop_panics {
+                eprintln!("error: {e}");
+            }
+            return Err(first);
+        }
+        (Err(e), first_drop_panic) => {
+            for d in first_drop_panic.into_iter().chain(drop_panics) {
+                eprintln!("error: {d}");
+            }
+            return Err(e);
+        }
+    };
+    print_summary(&summary, args.json, args.quiet)
+}
+
+/// Runs (or resumes) the session `args` describe; every component is
+/// dropped before this returns.
+fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
     let start = match (&args.resume, &args.config) {
         (Some(log), _) => Start::Resume(log.clone()),
         (None, Some(config)) => Start::Fresh {
@@ -106,14 +135,17 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
             let text = hil_core::files::read_text(&config, hil_core::files::limits::CONFIG)?;
             let cfg = ExperimentConfig::parse(&text, &config)?;
             // Absolute, so that a resume from another directory finds the
-            // same files.
-            let base = absolute(config.parent().unwrap_or(Path::new(".")))?;
+            // same files; made absolute before taking the directory, which
+            // for a bare file name (`exp.toml`) is empty.
+            let config_abs = absolute(&config)?;
+            let base = config_abs
+                .parent()
+                .map_or_else(|| config_abs.clone(), Path::to_path_buf);
             let mut exp = cfg.build(&base)?;
             announce_endpoint(exp.channel.endpoint());
             match log {
                 Some(log_path) => {
-                    let header =
-                        Header::new(&text, absolute(&config)?, base, exp.seed, exp.episodes);
+                    let header = Header::new(&text, config_abs, base, exp.seed, exp.episodes);
                     let log = RecordLog::create(&log_path, header)?;
                     if !quiet {
                         eprintln!("recording to {}", log_path.display());
@@ -153,7 +185,7 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
             .flush()
             .map_err(|e| HilError::io("writing", &s.path, e))?;
     }
-    print_summary(&summary, args.json, args.quiet)
+    Ok(summary)
 }
 
 /// On Ctrl-C (or SIGTERM), says what was kept and how to continue, then

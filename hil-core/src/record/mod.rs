@@ -70,6 +70,9 @@
 //! let log = RecordLog::create(&path, Header::new("seed = 1", "exp.toml", ".", 1, 1)).unwrap();
 //! let mut rec = Recorder::new(log);
 //! rec.emit(&Record::EpisodeStart { episode: 0, seed: 9 }).unwrap();
+//! // One writer at a time: the recorder still holds the log.
+//! assert!(RecordLog::open(&path).is_err());
+//! drop(rec);
 //! let (_, logged) = RecordLog::open(&path).unwrap();
 //! assert_eq!(logged.header.seed, 1);
 //! assert_eq!(logged.records.len(), 1);

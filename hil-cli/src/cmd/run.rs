@@ -21,7 +21,10 @@ pub struct RunArgs {
     pub log: Option<PathBuf>,
     /// Continue the session recorded in LOG (after a crash, a kill or an
     /// interrupt): the config comes from the log, answered queries are not
-    /// asked again, and new steps are appended to LOG.
+    /// asked again, and new steps are appended to LOG. A log has one
+    /// writer: this is refused, naming the process, while another hil
+    /// writes LOG; and a log changed since it was written is refused with
+    /// the line at fault.
     #[arg(long, value_name = "LOG", conflicts_with_all = ["config", "log"])]
     pub resume: Option<PathBuf>,
     /// Write every step event to this JSONL file.
@@ -63,27 +66,22 @@ enum Start {
 }
 
 pub fn run(args: RunArgs) -> hil_core::Result<()> {
-    let result = run_session(&args);
+    let result = run_session(&args).and_then(|s| print_summary(&s, args.json, args.quiet));
     // Every component has been dropped by now: a plugin object whose
-    // destructor panicked is reported (PLUGINS.md), not passed over.
-    let mut drop_panics = hil_core::plugin::take_destructor_panics().into_iter();
-    let summary = match (result, drop_panics.next()) {
-        (Ok(summary), None) => summary,
-        (Ok(summary), Some(first)) => {
-            print_summary(&summary, args.json, args.quiet)?;
-            for e in drop_panics {
-                eprintln!("error: {e}");
-            }
-            return Err(first);
-        }
-        (Err(e), first_drop_panic) => {
-            for d in first_drop_panic.into_iter().chain(drop_panics) {
-                eprintln!("error: {d}");
-            }
-            return Err(e);
-        }
+    // destructor panicked is reported (PLUGINS.md), not passed over. The
+    // first error is returned (and printed by `main`); any others are
+    // printed here.
+    let mut errors = result
+        .err()
+        .into_iter()
+        .chain(hil_core::plugin::take_destructor_panics());
+    let Some(first) = errors.next() else {
+        return Ok(());
     };
-    print_summary(&summary, args.json, args.quiet)
+    for e in errors {
+        eprintln!("error: {e}");
+    }
+    Err(first)
 }
 
 /// Runs (or resumes) the session `args` describe; every component is

@@ -1,6 +1,7 @@
 //! The interaction record's costs: one recorded step (a `step` line and an
 //! `outcome` line, each written and fsync'ed), and reading a long log back
-//! when resuming.
+//! when resuming (parsing and verifying every line's place in the hash
+//! chain).
 //!
 //! The log lives under `target/` (a real disk, not tmpfs), so the step cost
 //! is dominated by the disk's fsync latency.
@@ -8,6 +9,7 @@
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use hil_core::record::chain::Chain;
 use hil_core::record::{Header, Record, RecordLog, Recorder};
 use hil_core::{ArmId, Context, Outcome, PendingStep, SessionObserver, StepDecision, StepEvent};
 
@@ -56,10 +58,16 @@ fn bench(c: &mut Criterion) {
     });
 
     // The long log is written directly (no fsync per line), so that
-    // `cargo test --all-targets`, which runs this once, stays fast.
+    // `cargo test --all-targets`, which runs this once, stays fast; each
+    // line is chained as a log's writer chains it.
     let long = d.join("long.jsonl");
-    let mut text = serde_json::to_string(&Record::Header(Header::new("", "x", ".", 0, 1))).unwrap();
-    text.push('\n');
+    let mut chain = Chain::start();
+    let mut text = String::new();
+    let mut push = |r: &Record| {
+        text.push_str(&chain.seal(&serde_json::to_string(r).unwrap(), true));
+        text.push('\n');
+    };
+    push(&Record::Header(Header::new("", "x", ".", 0, 1)));
     for t in 1..=5000 {
         let e = step(t);
         let lines = [
@@ -73,9 +81,8 @@ fn bench(c: &mut Criterion) {
                 outcome: e.outcome,
             },
         ];
-        for r in lines {
-            text.push_str(&serde_json::to_string(&r).unwrap());
-            text.push('\n');
+        for r in &lines {
+            push(r);
         }
     }
     std::fs::write(&long, text).unwrap();

@@ -21,7 +21,10 @@ pub struct RunArgs {
     pub log: Option<PathBuf>,
     /// Continue the session recorded in LOG (after a crash, a kill or an
     /// interrupt): the config comes from the log, answered queries are not
-    /// asked again, and new steps are appended to LOG.
+    /// asked again, and new steps are appended to LOG. A log has one
+    /// writer: this is refused, naming the process, while another hil
+    /// writes LOG; and a log changed since it was written is refused with
+    /// the line at fault.
     #[arg(long, value_name = "LOG", conflicts_with_all = ["config", "log"])]
     pub resume: Option<PathBuf>,
     /// Write every step event to this JSONL file.
@@ -43,10 +46,12 @@ struct JsonlEvents {
 
 impl SessionObserver for JsonlEvents {
     fn on_step(&mut self, event: &StepEvent) -> hil_core::Result<()> {
-        serde_json::to_writer(&mut self.out, event)
-            .map_err(|e| HilError::serde("step event", e))?;
+        // Serialised apart from writing, so that a failing file (a full
+        // disk, /dev/full) is reported as an I/O error naming it.
+        let mut line = serde_json::to_vec(event).map_err(|e| HilError::serde("step event", e))?;
+        line.push(b'\n');
         self.out
-            .write_all(b"\n")
+            .write_all(&line)
             .map_err(|e| HilError::io("writing", &self.path, e))
     }
 }
@@ -61,6 +66,27 @@ enum Start {
 }
 
 pub fn run(args: RunArgs) -> hil_core::Result<()> {
+    let result = run_session(&args).and_then(|s| print_summary(&s, args.json, args.quiet));
+    // Every component has been dropped by now: a plugin object whose
+    // destructor panicked is reported (PLUGINS.md), not passed over. The
+    // first error is returned (and printed by `main`); any others are
+    // printed here.
+    let mut errors = result
+        .err()
+        .into_iter()
+        .chain(hil_core::plugin::take_destructor_panics());
+    let Some(first) = errors.next() else {
+        return Ok(());
+    };
+    for e in errors {
+        eprintln!("error: {e}");
+    }
+    Err(first)
+}
+
+/// Runs (or resumes) the session `args` describe; every component is
+/// dropped before this returns.
+fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
     let start = match (&args.resume, &args.config) {
         (Some(log), _) => Start::Resume(log.clone()),
         (None, Some(config)) => Start::Fresh {
@@ -106,14 +132,17 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
             let text = hil_core::files::read_text(&config, hil_core::files::limits::CONFIG)?;
             let cfg = ExperimentConfig::parse(&text, &config)?;
             // Absolute, so that a resume from another directory finds the
-            // same files.
-            let base = absolute(config.parent().unwrap_or(Path::new(".")))?;
+            // same files; made absolute before taking the directory, which
+            // for a bare file name (`exp.toml`) is empty.
+            let config_abs = absolute(&config)?;
+            let base = config_abs
+                .parent()
+                .map_or_else(|| config_abs.clone(), Path::to_path_buf);
             let mut exp = cfg.build(&base)?;
             announce_endpoint(exp.channel.endpoint());
             match log {
                 Some(log_path) => {
-                    let header =
-                        Header::new(&text, absolute(&config)?, base, exp.seed, exp.episodes);
+                    let header = Header::new(&text, config_abs, base, exp.seed, exp.episodes);
                     let log = RecordLog::create(&log_path, header)?;
                     if !quiet {
                         eprintln!("recording to {}", log_path.display());
@@ -153,7 +182,7 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
             .flush()
             .map_err(|e| HilError::io("writing", &s.path, e))?;
     }
-    print_summary(&summary, args.json, args.quiet)
+    Ok(summary)
 }
 
 /// On Ctrl-C (or SIGTERM), says what was kept and how to continue, then

@@ -9,7 +9,10 @@ use super::registrar::PluginRegistrar;
 
 /// Version of the plugin ABI: the layout of [`PluginDeclaration`], the
 /// [`PluginRegistrar`] trait and the factory signatures. Bumped on any change.
-pub const ABI_VERSION: u32 = 1;
+///
+/// - 2: [`PluginRegistrar::drop_panic_sink`] (destructor panics reach the host);
+/// - 1: the first.
+pub const ABI_VERSION: u32 = 2;
 
 // The header's first fields must never move: hosts of every ABI version read
 // them from plugins of every other.

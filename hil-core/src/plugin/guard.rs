@@ -14,11 +14,17 @@
 //! object was built (`name`, `n_arms`, `dim`, `action_space`,
 //! `context_dim`) or answer "nothing" (`best_action`, `current_item` return
 //! `None`) and poison the object, so the next fallible call reports it.
+//!
+//! A destructor cannot return an error, so a panic while a plugin object is
+//! dropped is sent to the host's [`DropPanicSink`] (which the host hands
+//! over through [`super::PluginRegistrar::drop_panic_sink`]) and collected
+//! there until the host asks for it with [`take_destructor_panics`]: `hil`
+//! reports it as an error after the run, instead of carrying on silently.
 
 use std::any::Any;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use serde_json::Value;
 
@@ -46,6 +52,39 @@ fn panicked(lib: &Path, name: &str, method: &str, payload: &(dyn Any + Send)) ->
     }
 }
 
+/// Where a panic in a plugin object's destructor is reported: a plain
+/// function of the host's, so that the error lands in the host's copy of
+/// hil-core whichever copy (the plugin's) ran the destructor.
+pub type DropPanicSink = fn(HilError);
+
+/// The destructor panics reported so far, in the copy of hil-core that owns
+/// this static (the host's, through [`report_drop_panic`]).
+static DROP_PANICS: Mutex<Vec<HilError>> = Mutex::new(Vec::new());
+
+/// The host's [`DropPanicSink`]: remembers the error for
+/// [`take_destructor_panics`].
+pub fn report_drop_panic(error: HilError) {
+    DROP_PANICS
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+        .push(error);
+}
+
+/// Takes the errors of every plugin destructor that panicked since the last
+/// call (a [`HilError::Plugin`] each, naming the library, the type and
+/// `drop`). A host calls it once it has dropped its plugin objects.
+///
+/// ```
+/// assert!(hil_core::plugin::take_destructor_panics().is_empty());
+/// ```
+pub fn take_destructor_panics() -> Vec<HilError> {
+    std::mem::take(
+        &mut *DROP_PANICS
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner()),
+    )
+}
+
 /// Runs `f`, turning a panic into a [`HilError::Plugin`].
 pub(crate) fn call<T>(
     lib: &Path,
@@ -63,6 +102,8 @@ struct Guard {
     name: String,
     /// The method and message of the first panic.
     poisoned: OnceLock<String>,
+    /// Where a panic in the destructor goes.
+    on_drop_panic: DropPanicSink,
 }
 
 impl Guard {
@@ -71,6 +112,15 @@ impl Guard {
             library,
             name: name.to_string(),
             poisoned: OnceLock::new(),
+            on_drop_panic: report_drop_panic,
+        }
+    }
+
+    /// Drops a plugin object under the guard: a panicking destructor is
+    /// reported to the sink as this object's panic in `drop`.
+    fn drop_guarded<T>(&self, inner: Option<T>) {
+        if let Err(p) = catch_unwind(AssertUnwindSafe(move || drop(inner))) {
+            (self.on_drop_panic)(panicked(&self.library, &self.name, "drop", &*p));
         }
     }
 
@@ -116,19 +166,13 @@ impl Guard {
     }
 }
 
-/// Drops a plugin object under the guard: a panicking destructor is
-/// reported by the plugin's panic hook and otherwise ignored.
-fn drop_guarded<T>(inner: Option<T>) {
-    let _ = catch_unwind(AssertUnwindSafe(move || drop(inner)));
-}
-
 /// Reads values to cache from a new object; if that panics, the object is
 /// dropped under the guard too and the panic is the error.
 fn cache<O, T>(guard: &Guard, method: &str, inner: O, f: impl FnOnce(&O) -> T) -> Result<(O, T)> {
     match guard.run(method, || Ok(f(&inner))) {
         Ok(v) => Ok((inner, v)),
         Err(e) => {
-            drop_guarded(Some(inner));
+            guard.drop_guarded(Some(inner));
             Err(e)
         }
     }
@@ -195,9 +239,20 @@ impl<T: ?Sized, F> Guarded<T, F> {
     }
 }
 
+impl<T: ?Sized, F> Guarded<T, F> {
+    /// Sends a panic in the wrapped object's destructor to `sink` (by
+    /// default, [`report_drop_panic`] of the copy of hil-core that built
+    /// the wrapper; a plugin's registrar passes the host's).
+    pub fn reporting_drop_panics_to(mut self, sink: DropPanicSink) -> Self {
+        self.guard.on_drop_panic = sink;
+        self
+    }
+}
+
 impl<T: ?Sized, F> Drop for Guarded<T, F> {
     fn drop(&mut self) {
-        drop_guarded(self.inner.take());
+        let inner = self.inner.take();
+        self.guard.drop_guarded(inner);
     }
 }
 

@@ -65,7 +65,10 @@ pub use abi::{
     PluginHeader, RegisterFn, interface_layout,
 };
 pub use config::{KindOf, PluginComponent, component, optional_component};
-pub use guard::{Guarded, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload};
+pub use guard::{
+    DropPanicSink, Guarded, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload,
+    report_drop_panic, take_destructor_panics,
+};
 pub use registrar::{
     ComponentKind, EnvironmentFactory, Factory, ParamFormat, Params, PluginRegistrar,
     PolicyFactory, QueryChannelFactory, Registrar, WorkloadModelFactory,

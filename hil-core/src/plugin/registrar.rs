@@ -12,7 +12,9 @@ use std::sync::Arc;
 
 use serde::de::DeserializeOwned;
 
-use super::guard::{self, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload};
+use super::guard::{
+    self, DropPanicSink, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload,
+};
 use crate::config::BuildContext;
 use crate::error::{HilError, Result};
 use crate::{Environment, Policy, QueryChannel, WorkloadModel};
@@ -188,6 +190,14 @@ pub trait PluginRegistrar {
     /// Adds a named factory. Problems (a duplicate or invalid name) are
     /// collected by the host and refuse the whole library after `register`.
     fn add(&mut self, name: &str, description: &str, factory: Factory);
+
+    /// Where the plugin's objects report a panic in their destructor. The
+    /// default is the host's own [`guard::report_drop_panic`] (this method
+    /// is compiled into the host, so the function is the host's), which
+    /// [`super::take_destructor_panics`] reads.
+    fn drop_panic_sink(&self) -> DropPanicSink {
+        guard::report_drop_panic
+    }
 }
 
 /// What a plugin's registration function receives: registers named,
@@ -209,6 +219,7 @@ pub trait PluginRegistrar {
 pub struct Registrar<'a> {
     host: &'a mut dyn PluginRegistrar,
     library: PathBuf,
+    drop_sink: DropPanicSink,
 }
 
 impl std::fmt::Debug for Registrar<'_> {
@@ -223,7 +234,12 @@ impl<'a> Registrar<'a> {
     /// Wraps the host's registrar.
     pub fn new(host: &'a mut dyn PluginRegistrar) -> Self {
         let library = host.library().to_path_buf();
-        Self { host, library }
+        let drop_sink = host.drop_panic_sink();
+        Self {
+            host,
+            library,
+            drop_sink,
+        }
     }
 
     /// Registers a policy factory under `name`.
@@ -231,8 +247,11 @@ impl<'a> Registrar<'a> {
     where
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn Policy>> + Send + Sync + 'static,
     {
-        let guard = |inner, lib, n: &str| {
-            Ok(Box::new(GuardedPolicy::new(inner, lib, n)?) as Box<dyn Policy>)
+        let guard = |inner, lib, n: &str, sink| {
+            Ok(
+                Box::new(GuardedPolicy::new(inner, lib, n)?.reporting_drop_panics_to(sink))
+                    as Box<dyn Policy>,
+            )
         };
         self.add(name, description, factory, guard, Factory::Policy);
     }
@@ -242,8 +261,11 @@ impl<'a> Registrar<'a> {
     where
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn Environment>> + Send + Sync + 'static,
     {
-        let guard = |inner, lib, n: &str| {
-            Ok(Box::new(GuardedEnvironment::new(inner, lib, n)?) as Box<dyn Environment>)
+        let guard = |inner, lib, n: &str, sink| {
+            Ok(
+                Box::new(GuardedEnvironment::new(inner, lib, n)?.reporting_drop_panics_to(sink))
+                    as Box<dyn Environment>,
+            )
         };
         self.add(name, description, factory, guard, Factory::Environment);
     }
@@ -253,8 +275,11 @@ impl<'a> Registrar<'a> {
     where
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn WorkloadModel>> + Send + Sync + 'static,
     {
-        let guard = |inner, lib, n: &str| {
-            Ok(Box::new(GuardedWorkload::new(inner, lib, n)?) as Box<dyn WorkloadModel>)
+        let guard = |inner, lib, n: &str, sink| {
+            Ok(
+                Box::new(GuardedWorkload::new(inner, lib, n)?.reporting_drop_panics_to(sink))
+                    as Box<dyn WorkloadModel>,
+            )
         };
         self.add(name, description, factory, guard, Factory::WorkloadModel);
     }
@@ -264,8 +289,11 @@ impl<'a> Registrar<'a> {
     where
         F: Fn(&Params, &BuildContext) -> Result<Box<dyn QueryChannel>> + Send + Sync + 'static,
     {
-        let guard = |inner, lib, n: &str| {
-            Ok(Box::new(GuardedChannel::new(inner, lib, n)?) as Box<dyn QueryChannel>)
+        let guard = |inner, lib, n: &str, sink| {
+            Ok(
+                Box::new(GuardedChannel::new(inner, lib, n)?.reporting_drop_panics_to(sink))
+                    as Box<dyn QueryChannel>,
+            )
         };
         self.add(name, description, factory, guard, Factory::QueryChannel);
     }
@@ -279,17 +307,21 @@ impl<'a> Registrar<'a> {
         name: &str,
         description: &str,
         factory: impl Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync + 'static,
-        guard: fn(Box<T>, PathBuf, &str) -> Result<Box<T>>,
+        guard: GuardFn<T>,
         kind: fn(FactoryOf<T>) -> Factory,
     ) {
-        let (lib, n) = (self.library.clone(), name.to_string());
+        let (lib, n, sink) = (self.library.clone(), name.to_string(), self.drop_sink);
         let f = Arc::new(move |p: &Params, ctx: &BuildContext| {
             let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
-            guard(inner, lib.clone(), &n)
+            guard(inner, lib.clone(), &n, sink)
         });
         self.host.add(name, description, kind(f));
     }
 }
+
+/// Wraps what a factory built in its panic guard: the object, its library,
+/// its registered name, and where a panic in its destructor goes.
+type GuardFn<T> = fn(Box<T>, PathBuf, &str, DropPanicSink) -> Result<Box<T>>;
 
 /// Runs a plugin's registration function under a panic guard. Called by the
 /// code [`crate::declare_plugin!`] generates, inside the plugin.

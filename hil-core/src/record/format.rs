@@ -14,11 +14,13 @@ use crate::time::Timestep;
 pub const FORMAT_NAME: &str = "hil-interaction-record";
 /// The version of the format this crate writes and reads.
 ///
+/// - 3: every line starts with a `chain` digest ([`super::chain`]) and the
+///   header carries `config_digest`, the SHA-256 of its `config`;
 /// - 2: a step's workload is `wl_t`, the paper's WL_t = f(WL_0, Q_t) at every
 ///   step, and episode metrics score WL_T at the last step (with `t_final`,
 ///   `queries` and `scoring_model`);
 /// - 1: a step's `wl` was the workload tracked at query steps only.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// The first line of a log: everything needed to rebuild the session.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -37,6 +39,9 @@ pub struct Header {
     pub base_dir: PathBuf,
     /// The experiment config, verbatim (TOML).
     pub config: String,
+    /// SHA-256 of `config` (lower-case hex): checked when the log is read,
+    /// so the config a session resumes with is the one it started with.
+    pub config_digest: String,
 }
 
 impl Header {
@@ -56,6 +61,7 @@ impl Header {
             config_path: config_path.into(),
             base_dir: base_dir.into(),
             config: config.into(),
+            config_digest: super::chain::digest_hex(config),
         }
     }
 }

@@ -1,28 +1,42 @@
-//! The log file: durable appends, and reading back with a torn last line
-//! detected and discarded.
+//! The log file: durable, chained appends by its one writer, and reading
+//! back with a torn last line detected and discarded and every complete
+//! line verified.
 
 use std::fs::{File, OpenOptions};
-use std::io::{Read, Seek, SeekFrom, Write};
+use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
+use serde::Deserialize;
+
 use crate::error::{HilError, Result};
+use crate::files::{limits, read_bytes};
+use crate::record::chain::{self, Chain};
 use crate::record::format::{FORMAT_NAME, FORMAT_VERSION, Header, Record};
+use crate::record::lock;
 
 /// An append-only JSONL file whose every line reaches the disk (fsync)
 /// before [`RecordLog::append`] returns.
+///
+/// A `RecordLog` is the log's only writer: creating or opening one takes an
+/// exclusive lock on the file (see [`super::lock`]), held until it is
+/// dropped, so a second writer (another `hil run --resume`, or a resume
+/// while the original run is still going) is refused with an
+/// [`HilError::Io`] of kind `WouldBlock` that names the holder.
 #[derive(Debug)]
 pub struct RecordLog {
     path: PathBuf,
     file: File,
     lines: usize,
+    chain: Chain,
 }
 
-/// A logged record with its line number (1-based) and exact text.
+/// A logged record with its line number (1-based) and exact content.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoggedRecord {
     /// 1-based line number.
     pub line: usize,
-    /// The line, without its newline.
+    /// The record's JSON as written: the line without its newline and
+    /// without its `chain` field (which depends on the lines before it).
     pub text: String,
     /// The parsed record.
     pub record: Record,
@@ -40,8 +54,9 @@ pub struct LoggedSession {
 }
 
 impl RecordLog {
-    /// Creates a new log at `path` starting with `header`. Refuses to
-    /// overwrite an existing file (it may hold a session to resume).
+    /// Creates a new log at `path` starting with `header`, and locks it.
+    /// Refuses to overwrite an existing file (it may hold a session to
+    /// resume).
     pub fn create(path: &Path, header: Header) -> Result<Self> {
         let file = OpenOptions::new()
             .write(true)
@@ -49,54 +64,78 @@ impl RecordLog {
             .open(path)
             .map_err(|e| HilError::io("creating", path, e))?;
         sync_parent_dir(path);
-        let mut log = Self {
-            path: path.to_path_buf(),
-            file,
-            lines: 0,
-        };
+        let mut log = Self::locked(path, file)?;
         log.append(&Record::Header(header))?;
         Ok(log)
     }
 
-    /// Opens an existing log for resuming: reads and validates every line,
-    /// cuts off an incomplete last line (a write the process did not finish,
-    /// so the robot never acted on it) and positions for appending.
+    /// Opens an existing log for resuming: locks it, reads it (at most
+    /// [`limits::LOG`] bytes, a regular file only), verifies every complete
+    /// line (its record and its place in the hash chain), cuts off an
+    /// incomplete last line (a write the process did not finish, so the
+    /// robot never acted on it) and positions for appending.
+    ///
+    /// Every error names the file, and where a line is at fault, the line
+    /// and field ([`HilError::Data`]).
     pub fn open(path: &Path) -> Result<(Self, LoggedSession)> {
-        let mut file = OpenOptions::new()
+        // Opening for writing never blocks (not even on a FIFO); anything
+        // that is not a regular file is then refused by `read_bytes`.
+        let file = OpenOptions::new()
             .read(true)
             .write(true)
             .open(path)
             .map_err(|e| HilError::io("opening", path, e))?;
-        let mut bytes = Vec::new();
-        file.read_to_end(&mut bytes)
-            .map_err(|e| HilError::io("reading", path, e))?;
+        // Locked before reading, so that nobody appends while we read.
+        let mut log = Self::locked(path, file)?;
+        let bytes = read_bytes(path, limits::LOG)?;
         let complete = bytes.iter().rposition(|b| *b == b'\n').map_or(0, |p| p + 1);
         let truncated_bytes = (bytes.len() - complete) as u64;
-        let session = parse(path, &bytes[..complete], truncated_bytes)?;
+        let (session, chain) = parse(path, &bytes[..complete], truncated_bytes)?;
         if truncated_bytes > 0 {
-            file.set_len(complete as u64)
-                .and_then(|()| file.sync_data())
+            log.file
+                .set_len(complete as u64)
+                .and_then(|()| log.file.sync_data())
                 .map_err(|e| HilError::io("truncating", path, e))?;
         }
-        file.seek(SeekFrom::End(0))
+        log.file
+            .seek(SeekFrom::End(0))
             .map_err(|e| HilError::io("seeking in", path, e))?;
+        log.lines = session.records.len() + 1;
+        log.chain = chain;
+        Ok((log, session))
+    }
+
+    /// Locks `file` (the log at `path`) and records this process as its
+    /// owner.
+    fn locked(path: &Path, file: File) -> Result<Self> {
+        lock::lock(&file, path)?;
+        // From here on, dropping the log removes the owner file.
         let log = Self {
             path: path.to_path_buf(),
             file,
-            lines: session.records.len() + 1,
+            lines: 0,
+            chain: Chain::start(),
         };
-        Ok((log, session))
+        lock::claim(path)?;
+        Ok(log)
     }
 
     /// Appends `record` as one line and waits until it is on disk.
     pub fn append(&mut self, record: &Record) -> Result<()> {
-        let mut line = serde_json::to_string(record)
+        let content = serde_json::to_string(record)
             .map_err(|e| HilError::serde(format!("{} record", record.kind()), e))?;
-        self.append_text(&mut line)
+        self.write_line(&content, !matches!(record, Record::Resumed { .. }))
     }
 
-    /// Appends already-serialised text (no newline) and fsyncs.
-    pub(crate) fn append_text(&mut self, line: &mut String) -> Result<()> {
+    /// Appends an already-serialised record (not a `resumed` marker) and
+    /// fsyncs.
+    pub(crate) fn append_text(&mut self, content: &str) -> Result<()> {
+        self.write_line(content, true)
+    }
+
+    fn write_line(&mut self, content: &str, advance: bool) -> Result<()> {
+        let mut chain = self.chain;
+        let mut line = chain.seal(content, advance);
         line.push('\n');
         // One write call per line: a kill leaves either the whole line or a
         // prefix without its newline, which `open` discards.
@@ -104,7 +143,8 @@ impl RecordLog {
             .write_all(line.as_bytes())
             .and_then(|()| self.file.sync_data())
             .map_err(|e| HilError::io("writing", &self.path, e))?;
-        line.pop();
+        // Only a line that reached the file moves the chain on.
+        self.chain = chain;
         self.lines += 1;
         Ok(())
     }
@@ -120,6 +160,13 @@ impl RecordLog {
     }
 }
 
+impl Drop for RecordLog {
+    fn drop(&mut self) {
+        // While the lock is still held (the file closes after this).
+        lock::release(&self.path);
+    }
+}
+
 /// Makes the new file's directory entry durable too (best effort: not every
 /// platform can open a directory).
 fn sync_parent_dir(path: &Path) {
@@ -132,7 +179,57 @@ fn sync_parent_dir(path: &Path) {
     }
 }
 
-fn parse(path: &Path, bytes: &[u8], truncated_bytes: u64) -> Result<LoggedSession> {
+/// What the first line of any version of the format says about itself.
+#[derive(Deserialize)]
+struct VersionProbe {
+    record: Option<String>,
+    format: Option<String>,
+    version: Option<u32>,
+}
+
+/// Refuses a first line that is not a header of this format and version,
+/// before anything else about the log is trusted.
+fn check_version(raw: &str) -> std::result::Result<(), (&'static str, String)> {
+    let probe: VersionProbe =
+        serde_json::from_str(raw).map_err(|e| ("record", format!("not a valid record: {e}")))?;
+    match probe.record.as_deref() {
+        Some("header") => {}
+        Some(kind) => return Err(("record", format!("expected a header, found `{kind}`"))),
+        None => {
+            return Err((
+                "record",
+                "expected a header, found no `record` field".into(),
+            ));
+        }
+    }
+    let format = probe.format.unwrap_or_default();
+    if format != FORMAT_NAME {
+        return Err(("format", format!("`{format}` is not `{FORMAT_NAME}`")));
+    }
+    let version = probe.version.unwrap_or(0);
+    let why = match version {
+        FORMAT_VERSION => return Ok(()),
+        1 => format!(
+            "the log was written in format version 1, which tracked workload only at query \
+             steps; this hil writes version {FORMAT_VERSION}, which scores WL_T as the paper \
+             does, and cannot resume it: run the session again from its config"
+        ),
+        v if v < FORMAT_VERSION => format!(
+            "the log was written in format version {v}, whose lines carry no hash chain, so \
+             this hil (version {FORMAT_VERSION}) cannot check that it is unchanged and will not \
+             resume it: run the session again from its config"
+        ),
+        v => format!(
+            "the log was written in format version {v} by a newer hil; this one reads version \
+             {FORMAT_VERSION}"
+        ),
+    };
+    Err(("version", why))
+}
+
+/// Parses and verifies the complete lines of a log; returns what it holds
+/// and the chain value after its last line.
+fn parse(path: &Path, bytes: &[u8], truncated_bytes: u64) -> Result<(LoggedSession, Chain)> {
     let data_err = |line: usize, field: &str, why: String| HilError::Data {
         path: path.to_path_buf(),
         record: line,
@@ -149,52 +246,48 @@ fn parse(path: &Path, bytes: &[u8], truncated_bytes: u64) -> Result<LoggedSessio
     })?;
     let mut header = None;
     let mut records = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
+    let mut chain = Chain::start();
+    for (i, raw) in text.split_terminator('\n').enumerate() {
         let line = i + 1;
-        let record: Record = serde_json::from_str(raw)
+        if line == 1 {
+            check_version(raw).map_err(|(field, why)| data_err(1, field, why))?;
+        }
+        let (digest, content) = chain::split(raw).ok_or_else(|| {
+            data_err(
+                line,
+                chain::FIELD,
+                format!(
+                    "the line does not start with its `{}` digest (64 hex digits): it was not \
+                     written by hil, or was edited",
+                    chain::FIELD
+                ),
+            )
+        })?;
+        let record: Record = serde_json::from_str(&content)
             .map_err(|e| data_err(line, "record", format!("not a valid record: {e}")))?;
-        match (&record, line) {
-            (Record::Header(h), 1) => {
-                if h.format != FORMAT_NAME {
-                    return Err(data_err(
-                        1,
-                        "format",
-                        format!("`{}` is not `{FORMAT_NAME}`", h.format),
-                    ));
-                }
-                if h.version != FORMAT_VERSION {
-                    let why = if h.version < FORMAT_VERSION {
-                        format!(
-                            "the log was written in format version {}, which tracked workload \
-                             only at query steps; this hil writes version {FORMAT_VERSION}, \
-                             which scores WL_T as the paper does, and cannot resume it: \
-                             run the session again from its config",
-                            h.version
-                        )
-                    } else {
-                        format!(
-                            "the log was written in format version {} by a newer hil; this \
-                             one reads version {FORMAT_VERSION}",
-                            h.version
-                        )
-                    };
-                    return Err(data_err(1, "version", why));
-                }
-                header = Some(h.clone());
-            }
+        // Checked first, as the more precise of the two complaints.
+        if let Record::Header(h) = &record
+            && h.config_digest != chain::digest_hex(&h.config)
+        {
+            return Err(data_err(
+                line,
+                "config_digest",
+                "the header's config is not the one the session started with (its SHA-256 \
+                 differs from `config_digest`)"
+                    .into(),
+            ));
+        }
+        chain
+            .check(digest, &content, !matches!(record, Record::Resumed { .. }))
+            .map_err(|why| data_err(line, chain::FIELD, why))?;
+        match (record, line) {
+            (Record::Header(h), 1) => header = Some(h),
             (Record::Header(_), _) => {
                 return Err(data_err(line, "record", "a second header".into()));
             }
-            (_, 1) => {
-                return Err(data_err(
-                    1,
-                    "record",
-                    format!("expected a header, found `{}`", record.kind()),
-                ));
-            }
-            _ => records.push(LoggedRecord {
+            (record, _) => records.push(LoggedRecord {
                 line,
-                text: raw.to_string(),
+                text: content,
                 record,
             }),
         }
@@ -207,9 +300,12 @@ fn parse(path: &Path, bytes: &[u8], truncated_bytes: u64) -> Result<LoggedSessio
                 .into(),
         )
     })?;
-    Ok(LoggedSession {
-        header,
-        records,
-        truncated_bytes,
-    })
+    Ok((
+        LoggedSession {
+            header,
+            records,
+            truncated_bytes,
+        },
+        chain,
+    ))
 }

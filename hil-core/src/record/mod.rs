@@ -3,17 +3,36 @@
 //!
 //! # Format
 //!
-//! One JSON object per line, tagged by its `record` field (see [`Record`]):
+//! One JSON object per line, tagged by its `record` field (see [`Record`]).
+//! Every line starts with a `chain` field, the SHA-256 of the previous
+//! line's `chain` and the line's own content ([`chain`]), which makes the
+//! log tamper-evident.
 //!
 //! | record | when | fields |
 //! |---|---|---|
-//! | `header` | first line | `format` (`hil-interaction-record`), `version` (2), `seed`, `episodes`, `config_path`, `base_dir`, `config` (the experiment TOML, verbatim) |
+//! | `header` | first line | `format` (`hil-interaction-record`), `version` (3), `seed`, `episodes`, `config_path`, `base_dir`, `config` (the experiment TOML, verbatim), `config_digest` (its SHA-256) |
 //! | `episode_start` | episode begins | `episode`, `seed` |
 //! | `step` | decided, **fsync'ed before the robot acts** | `episode`, `step`: `t`, `item_index`, `item_label`, `attempt`, `context`, `decision` (`act` / `query` with its `kind` = response type, difficulty, distraction, and `fallback` / `follow_expert`), `diagnostics`, `response` (answer, expert arm, response time; a `timed_out` answer means the policy acted on its own), `arm`, `wl_t` (WL_t = f(WL_0, Q_t) at this step) |
 //! | `outcome` | after execution, fsync'ed | `episode`, `t`, `outcome` (`success`, `success_probability`) |
 //! | `episode_end` | episode ends | `episode`, `metrics` |
 //! | `checkpoint` | after `episode_end`, if the policy can save its state | `episode`, `policy` (its [`crate::Policy::save`]) |
 //! | `resumed` | where a resumed session started appending | `lines`, `truncated_bytes`, `from_checkpoint` |
+//!
+//! # One writer, and tamper evidence
+//!
+//! A [`RecordLog`] holds an exclusive lock on its file for as long as it
+//! lives ([`lock`]): a second writer, such as a second `hil run --resume` or
+//! a resume while the original run still writes, is refused with an error
+//! naming the process, host and start time of the holder.
+//!
+//! [`RecordLog::open`] reads at most [`crate::files::limits::LOG`] bytes of
+//! a regular file and verifies every complete line before anything is
+//! resumed: its record, its place in the hash chain, and the header's
+//! `config_digest`. A flipped bit anywhere (an `episode_end` before the
+//! last checkpoint included), an edited checkpoint, removed or reordered
+//! lines, a header spliced from another log, or an edited config are
+//! refused with the line at fault. The chain has no key: it catches
+//! corruption and edits, not a forger who recomputes it.
 //!
 //! # Resuming
 //!
@@ -51,13 +70,18 @@
 //! let log = RecordLog::create(&path, Header::new("seed = 1", "exp.toml", ".", 1, 1)).unwrap();
 //! let mut rec = Recorder::new(log);
 //! rec.emit(&Record::EpisodeStart { episode: 0, seed: 9 }).unwrap();
+//! // One writer at a time: the recorder still holds the log.
+//! assert!(RecordLog::open(&path).is_err());
+//! drop(rec);
 //! let (_, logged) = RecordLog::open(&path).unwrap();
 //! assert_eq!(logged.header.seed, 1);
 //! assert_eq!(logged.records.len(), 1);
 //! # std::fs::remove_dir_all(&dir).unwrap();
 //! ```
 
+pub mod chain;
 pub mod format;
+pub mod lock;
 pub mod log;
 pub mod recorder;
 mod replay;
@@ -112,7 +136,8 @@ impl LoggedSession {
 /// Where a resumed session starts, derived from its log.
 struct ResumePlan {
     start_episode: usize,
-    restore: Option<(usize, serde_json::Value)>,
+    /// The checkpoint to restore: its episode, state and log line.
+    restore: Option<(usize, serde_json::Value, usize)>,
     metrics_before: Vec<EpisodeMetrics>,
     expected: Vec<LoggedRecord>,
     answers: VecDeque<LoggedAnswer>,
@@ -144,13 +169,13 @@ fn plan(session: &LoggedSession, log: &RecordLog) -> Result<ResumePlan> {
                 ends.push(metrics.clone());
             }
             Record::Checkpoint { episode, policy } if *episode + 1 == ends.len() => {
-                cut = Some((i, *episode, policy.clone()));
+                cut = Some((i, *episode, policy.clone(), r.line));
             }
             _ => {}
         }
     }
     let (first, start_episode, restore, metrics_before) = match cut {
-        Some((i, k, state)) => (i + 1, k + 1, Some((k, state)), ends[..=k].to_vec()),
+        Some((i, k, state, line)) => (i + 1, k + 1, Some((k, state, line)), ends[..=k].to_vec()),
         None => (0, 0, None, Vec::new()),
     };
     let expected: Vec<LoggedRecord> = session.records[first..]
@@ -218,16 +243,16 @@ pub fn run_recorded(
             let marker = Record::Resumed {
                 lines: log.lines(),
                 truncated_bytes: session.truncated_bytes,
-                from_checkpoint: plan.restore.as_ref().map(|(k, _)| *k),
+                from_checkpoint: plan.restore.as_ref().map(|(k, _, _)| *k),
             };
             let expected = std::mem::take(&mut plan.expected);
             (Recorder::resuming(log, expected, marker), plan)
         }
     };
-    if let Some((k, state)) = plan.restore {
+    if let Some((k, state, line)) = plan.restore {
         exp.policy.restore(state).map_err(|e| HilError::Data {
             path: path.clone(),
-            record: 0,
+            record: line,
             field: format!("checkpoint of episode {k}"),
             why: format!("the policy could not restore it: {e}"),
         })?;

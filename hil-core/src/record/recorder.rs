@@ -70,16 +70,18 @@ impl Recorder {
 
     /// Writes `record` (or verifies it against the log while replaying).
     pub fn emit(&mut self, record: &Record) -> Result<()> {
-        let mut text = serde_json::to_string(record)
+        let text = serde_json::to_string(record)
             .map_err(|e| HilError::serde(format!("{} record", record.kind()), e))?;
         // JSON has no NaN or infinity (serde_json writes them as null): a
         // record that does not read back would make the log unresumable,
-        // so it stops the session before the robot acts.
-        if serde_json::from_str::<Record>(&text).is_err() {
+        // so it stops the session before the robot acts. The session loop
+        // checks what components return first; this catches the rest.
+        if let Err(e) = serde_json::from_str::<Record>(&text) {
             return Err(HilError::invalid_input(
-                format!("{} record", record.kind()),
+                format!("{} record of episode {}", record.kind(), self.episode),
                 format!(
-                    "it contains a non-finite number (NaN or infinity) that a log cannot hold: {text}"
+                    "it contains a number a log cannot hold (NaN or infinity, written as \
+                     null): {e}"
                 ),
             ));
         }
@@ -90,8 +92,9 @@ impl Recorder {
                     record: logged.line,
                     field: logged.record.kind().to_string(),
                     why: format!(
-                        "the resumed session diverged from the log (was the config, a plugin or \
-                         the code changed?): the log has\n  {}\nbut the replay produced\n  {text}",
+                        "the resumed session diverged from the log (was a plugin, a file the \
+                         config names, or the code changed?): the log has\n  {}\nbut the replay \
+                         produced\n  {text}",
                         logged.text
                     ),
                 });
@@ -101,7 +104,7 @@ impl Recorder {
         if let Some(marker) = self.marker.take() {
             self.log.append(&marker)?;
         }
-        self.log.append_text(&mut text)
+        self.log.append_text(&text)
     }
 }
 

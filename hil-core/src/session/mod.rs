@@ -10,7 +10,12 @@
 //! - Workload is the paper's WL_t = f(WL_0, Q_t), evaluated at every step
 //!   with the session's workload model; the episode is scored at its last
 //!   step (WL_T, [`EpisodeMetrics`]).
+//! - What components return is checked as it arrives: a policy's
+//!   diagnostics must be finite, every workload prediction in [0, 1], a
+//!   response time finite and not negative, a success probability in
+//!   [0, 1]. The error names the component and the field.
 
+mod checks;
 pub mod event;
 pub mod observer;
 
@@ -186,11 +191,15 @@ impl Session<'_> {
             o.on_episode_start(seed)?;
         }
 
-        let mut tracker = WorkloadTracker::new(self.workload.clone(), self.settings.wl0)?;
-        let forecast_model = self
-            .forecast
-            .clone()
-            .unwrap_or_else(|| self.workload.clone());
+        // Every prediction, for the trace, the policy and the score, is
+        // checked to be a workload score.
+        let workload: Arc<dyn WorkloadModel> =
+            Arc::new(checks::CheckedWorkload(self.workload.clone()));
+        let mut tracker = WorkloadTracker::new(workload.clone(), self.settings.wl0)?;
+        let forecast_model: Arc<dyn WorkloadModel> = match &self.forecast {
+            Some(f) => Arc::new(checks::CheckedWorkload(f.clone())),
+            None => workload.clone(),
+        };
         let mut events = Vec::new();
         let mut t = 0;
         let mut items_seen = 0;
@@ -223,6 +232,7 @@ impl Session<'_> {
                             ),
                         };
                         let decision = self.policy.decide(&input)?;
+                        checks::diagnostics(self.policy.name(), &decision.diagnostics)?;
                         match decision.choice {
                             Choice::Act { arm } => {
                                 self.check_arm(arm, "policy decision")?;
@@ -244,6 +254,7 @@ impl Session<'_> {
                                     oracle_best: self.environment.best_action(),
                                 };
                                 let response = self.channel.ask(&query)?;
+                                checks::response(self.channel.name(), &response)?;
                                 // The person was interrupted whatever they answered.
                                 tracker.record(t, kind)?;
                                 let arm = match response.expert_arm {
@@ -311,8 +322,7 @@ impl Session<'_> {
             }
             items_seen += 1;
         }
-        let metrics =
-            EpisodeMetrics::from_events(&events, self.settings.wl0, self.workload.as_ref())?;
+        let metrics = EpisodeMetrics::from_events(&events, self.settings.wl0, workload.as_ref())?;
         for o in observers.iter_mut() {
             o.on_episode_end(&metrics)?;
         }

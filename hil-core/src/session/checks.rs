@@ -1,0 +1,143 @@
+//! Checks on what components hand back to the session loop.
+//!
+//! A policy, workload model or channel (built in or a plugin) may return a
+//! number the session cannot use: a NaN diagnostic, a workload of 2.83, an
+//! infinite response time. Passed on, such a value is scored, printed, or
+//! written to the log as `null` (JSON has no NaN), where it breaks resuming
+//! much later. So the loop checks every value when it arrives, and the
+//! error names the component and the field.
+
+use std::sync::Arc;
+
+use crate::decision::Diagnostics;
+use crate::error::{HilError, Result};
+use crate::query::{QueryKind, Response};
+use crate::time::Timestep;
+use crate::workload::{QueryHistory, WorkloadModel};
+
+/// Every diagnostic of a policy's decision must be finite.
+pub(crate) fn diagnostics(policy: &str, d: &Diagnostics) -> Result<()> {
+    let fields = d
+        .arms
+        .iter()
+        .enumerate()
+        .flat_map(|(i, a)| {
+            [
+                (format!("arms[{i}].estimate"), a.estimate),
+                (format!("arms[{i}].bonus"), a.bonus),
+                (format!("arms[{i}].ucb"), a.ucb),
+            ]
+        })
+        .chain(
+            [
+                ("gap", d.gap),
+                ("threshold", d.threshold),
+                ("query_probability", d.query_probability),
+                ("workload_forecast", d.workload_forecast),
+            ]
+            .into_iter()
+            .filter_map(|(name, v)| v.map(|v| (name.to_string(), v))),
+        );
+    for (field, v) in fields {
+        if !v.is_finite() {
+            return Err(HilError::invalid_input(
+                format!("`diagnostics.{field}` of policy `{policy}`"),
+                format!("{v} is not a finite number"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A response time, when a channel reports one, is a finite number of
+/// seconds, not negative.
+pub(crate) fn response(channel: &str, r: &Response) -> Result<()> {
+    match r.response_time_s {
+        Some(s) if !(s.is_finite() && s >= 0.0) => Err(HilError::invalid_input(
+            format!("`response_time_s` of query channel `{channel}`"),
+            format!("{s} is not a finite, non-negative number of seconds"),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// A workload model whose every prediction is checked to be a workload
+/// score in [0, 1]; the session tracks, forecasts and scores through it.
+pub(crate) struct CheckedWorkload(pub(crate) Arc<dyn WorkloadModel>);
+
+impl CheckedWorkload {
+    fn check(&self, wl: f64, t: Timestep, what: &str) -> Result<f64> {
+        if (0.0..=1.0).contains(&wl) {
+            return Ok(wl);
+        }
+        Err(HilError::invalid_input(
+            format!("`{what}` of workload model `{}`", self.0.name()),
+            format!("{wl} at t = {t} is not a workload score in [0, 1]"),
+        ))
+    }
+}
+
+impl WorkloadModel for CheckedWorkload {
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+
+    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
+        self.check(self.0.predict(wl0, history, t)?, t, "predict")
+    }
+
+    fn predict_if_queried(
+        &self,
+        wl0: f64,
+        history: &QueryHistory,
+        t: Timestep,
+        kind: QueryKind,
+    ) -> Result<f64> {
+        let wl = self.0.predict_if_queried(wl0, history, t, kind)?;
+        self.check(wl, t, "predict_if_queried")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::decision::ArmDiagnostics;
+
+    #[test]
+    fn the_first_non_finite_diagnostic_is_named() {
+        let mut d = Diagnostics {
+            arms: vec![ArmDiagnostics {
+                estimate: 0.1,
+                bonus: 0.2,
+                ucb: 0.3,
+            }],
+            gap: Some(0.5),
+            ..Default::default()
+        };
+        diagnostics("p", &d).unwrap();
+        d.arms[0].ucb = f64::INFINITY;
+        match diagnostics("p", &d).unwrap_err() {
+            HilError::InvalidInput { what, .. } => {
+                assert_eq!(what, "`diagnostics.arms[0].ucb` of policy `p`")
+            }
+            e => panic!("{e:?}"),
+        }
+        d.arms[0].ucb = 0.3;
+        d.query_probability = Some(f64::NAN);
+        let e = diagnostics("p", &d).unwrap_err().to_string();
+        assert!(e.contains("diagnostics.query_probability"), "{e}");
+    }
+
+    #[test]
+    fn response_times_must_be_finite_and_not_negative() {
+        let mut r = Response::action(crate::ArmId(0));
+        response("c", &r).unwrap();
+        for bad in [f64::INFINITY, f64::NAN, -1.0] {
+            r.response_time_s = Some(bad);
+            assert!(matches!(
+                response("c", &r),
+                Err(HilError::InvalidInput { .. })
+            ));
+        }
+    }
+}

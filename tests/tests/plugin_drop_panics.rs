@@ -1,0 +1,54 @@
+//! A plugin object whose destructor panics: the panic is caught inside the
+//! plugin and handed to the host as an error naming the library, the type
+//! and `drop` (what PLUGINS.md promises), for the host to report.
+//!
+//! Its own test binary: the host's list of destructor panics is global to
+//! the process, and the other plugin tests drop panicking objects too.
+
+use std::path::Path;
+
+use hil_core::plugin::{self, Params};
+use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
+use hil_core::{BuildContext, HilError};
+
+#[test]
+fn every_kind_of_object_reports_a_destructor_panic_to_the_host() {
+    let krate = "hil-test-plugin-panicky";
+    let ws = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+    let lib = cdylib_path(&build_cdylibs(ws, &[krate]).unwrap(), krate);
+    plugin::load(&lib).unwrap();
+    let ctx = BuildContext::new(".", 0);
+    let p = Params::toml("panic_in = \"drop\"");
+    assert!(plugin::take_destructor_panics().is_empty());
+
+    drop(plugin::build_policy("panicky_policy", &p, &ctx).unwrap());
+    drop(plugin::build_environment("panicky_env", &p, &ctx).unwrap());
+    drop(plugin::build_workload_model("panicky_workload", &p, &ctx).unwrap());
+    drop(plugin::build_query_channel("panicky_channel", &p, &ctx).unwrap());
+    // An object that does not panic reports nothing.
+    drop(plugin::build_policy("panicky_policy", &Params::empty(), &ctx).unwrap());
+
+    let reported = plugin::take_destructor_panics();
+    let names: Vec<String> = reported
+        .iter()
+        .map(|e| match e {
+            HilError::Plugin { path, why } => {
+                assert_eq!(path, &lib);
+                assert!(why.ends_with("panicked in drop: boom in drop"), "{why}");
+                why.split('`').nth(1).unwrap().to_string()
+            }
+            other => panic!("expected a plugin error, got {other:?}"),
+        })
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "panicky_policy",
+            "panicky_env",
+            "panicky_workload",
+            "panicky_channel"
+        ]
+    );
+    // Taken once.
+    assert!(plugin::take_destructor_panics().is_empty());
+}

@@ -21,6 +21,7 @@
 //! figure says so.
 
 pub mod calibrate;
+pub mod claims;
 pub mod method;
 pub mod output;
 pub mod plot;

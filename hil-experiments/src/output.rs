@@ -48,7 +48,8 @@ fn write(path: &Path, text: &str) -> Result<()> {
 }
 
 /// Writes `results.json` (both runs and the frontier), `tables.md` (the
-/// paper-protocol tables, then the many-seed tables), `rollout.svg`,
+/// paper-protocol tables, then the many-seed tables, then the paper's
+/// claims checked on the many-seed run, [`crate::claims`]), `rollout.svg`,
 /// `workload.svg` and `frontier.svg` into `dir`. The figures follow the
 /// settings' [`FigureSettings`], with hyperparameters as the many-seed run
 /// chose them (the paper-protocol run's if there is none)
@@ -82,6 +83,8 @@ pub fn write_outputs(
         md.push('\n');
         md.push_str(&tables_markdown(many, elapsed)?);
     }
+    md.push('\n');
+    md.push_str(&crate::claims::claims_markdown(reproduction.headline())?);
     write(&tables, &md)?;
     let results = reproduction.headline();
 

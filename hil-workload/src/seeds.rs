@@ -116,7 +116,8 @@ impl SeedSpread {
             .into_par_iter()
             .map(|s| Draw::of(config, s))
             .collect::<Result<_>>()?;
-        let col = |f: &dyn Fn(&Draw) -> f64| OverSeeds::of(&draws.iter().map(f).collect::<Vec<_>>());
+        let col =
+            |f: &dyn Fn(&Draw) -> f64| OverSeeds::of(&draws.iter().map(f).collect::<Vec<_>>());
         let mut ps: Vec<f64> = draws.iter().map(|d| d.p).collect();
         ps.sort_by(f64::total_cmp);
         let p_median = if ps.is_empty() {
@@ -168,8 +169,8 @@ impl SeedSpread {
 
 /// The calibration of the generator's level and spread parameters:
 /// starting from `config`, adjusts `params.mean` (the D1 level),
-/// `params.population_shift` (D2's extra level), `params.survey_sd` (D1's
-/// per-survey noise) and `params.limited_survey_sd` (D2's) until the mean
+/// `params.population_shift` (D2's extra level), `params.participant_sd` (the spread
+/// of participants' levels, which a model partly sees through WL_0) and `params.limited_survey_sd` (D2's) until the mean
 /// over `seeds` of the D1 and D2 means and sds is within `tolerance` of
 /// the paper's. A fixed-point iteration on the gaps (levels move with the
 /// gap, variances with the gap in variance); clamping and Likert rounding
@@ -189,9 +190,14 @@ pub fn centre(
         let g2 = PAPER_D2_MEAN - spread.d2_mean.mean;
         let v1 = PAPER_D1_SD.powi(2) - spread.d1_sd.mean.powi(2);
         let v2 = PAPER_D2_SD.powi(2) - spread.d2_sd.mean.powi(2);
-        if [g1, g2, PAPER_D1_SD - spread.d1_sd.mean, PAPER_D2_SD - spread.d2_sd.mean]
-            .iter()
-            .all(|g| g.abs() <= tolerance)
+        if [
+            g1,
+            g2,
+            PAPER_D1_SD - spread.d1_sd.mean,
+            PAPER_D2_SD - spread.d2_sd.mean,
+        ]
+        .iter()
+        .all(|g| g.abs() <= tolerance)
         {
             break;
         }
@@ -200,7 +206,7 @@ pub fn centre(
         p.mean = round(p.mean + g1);
         p.population_shift = round(p.population_shift + g2 - g1);
         // Independent noise: variances add.
-        p.survey_sd = round((p.survey_sd.powi(2) + v1).max(0.0).sqrt());
+        p.participant_sd = round((p.participant_sd.powi(2) + v1).max(0.0).sqrt());
         p.limited_survey_sd = round((p.limited_survey_sd.powi(2) + v2).max(0.0).sqrt());
         spread = SeedSpread::over(&c, seeds.clone())?;
     }

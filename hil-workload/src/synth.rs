@@ -19,7 +19,7 @@
 //! Average, so WL_0 must be a noisy, biased predictor of later workload). Each TLX
 //! subscale adds its own noise and is rounded to the 5-point scale.
 //! [`SynthParams`] holds the calibrated values: the level and spread
-//! parameters (`mean`, `population_shift`, `survey_sd`,
+//! parameters (`mean`, `population_shift`, `participant_sd`,
 //! `limited_survey_sd`) are centred so that the D1 and D2 means and sds,
 //! averaged over generator seeds 0..100, match the paper's
 //! (`hil workload seeds --count 100 --centre`, [`crate::seeds::centre`]);
@@ -78,9 +78,9 @@ pub struct SynthParams {
 impl Default for SynthParams {
     fn default() -> Self {
         Self {
-            mean: 0.3232,
-            population_shift: 0.0496,
-            participant_sd: 0.24,
+            mean: 0.3221,
+            population_shift: 0.0493,
+            participant_sd: 0.2846,
             baseline_share: 1.0,
             baseline_sd: 0.37,
             baseline_offset: -0.27,
@@ -90,10 +90,10 @@ impl Default for SynthParams {
             carry: 0.02,
             carry_tau_s: 90.0,
             condition_sd: 0.06,
-            survey_sd: 0.1955,
+            survey_sd: 0.13,
             item_sd: 0.1,
             limited_baseline_shift: 0.22,
-            limited_survey_sd: 0.1612,
+            limited_survey_sd: 0.0801,
         }
     }
 }

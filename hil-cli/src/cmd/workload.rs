@@ -342,8 +342,8 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 print!("{}", spread.to_text());
                 let p = &c.params;
                 println!(
-                    "calibrated: mean = {}, population_shift = {}, survey_sd = {}, limited_survey_sd = {}",
-                    p.mean, p.population_shift, p.survey_sd, p.limited_survey_sd
+                    "calibrated: mean = {}, population_shift = {}, participant_sd = {}, limited_survey_sd = {}",
+                    p.mean, p.population_shift, p.participant_sd, p.limited_survey_sd
                 );
             } else {
                 print!(

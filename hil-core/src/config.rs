@@ -636,11 +636,18 @@ fn find_value_line(text: &str, section: &[String], literal: &str) -> Option<(usi
             .unwrap_or("")
             .trim();
         let normalised = value.replace('\'', "\"");
-        if value == literal || normalised == literal {
+        if value == literal || normalised == literal || same_number(value, literal) {
             return Some((i + 1, key));
         }
     }
     None
+}
+
+/// Whether two number literals have the same value (`1e12` written,
+/// `1000000000000.0` quoted by serde).
+fn same_number(written: &str, quoted: &str) -> bool {
+    let number = |s: &str| s.replace('_', "").parse::<f64>().ok();
+    matches!((number(written), number(quoted)), (Some(a), Some(b)) if a == b)
 }
 
 fn find_header_line(text: &str, section: &[&str]) -> Option<usize> {

@@ -9,12 +9,6 @@ use hil_core::config::limits;
 use hil_core::error::ECHO_CHARS;
 use hil_core::{ConfigError, ExperimentConfig, HilError};
 
-// The component crates register their types when linked.
-use hil_channels::simulated::SimulatedExpertConfig as _;
-use hil_envs::demo_plate::DemoPlateConfig as _;
-use hil_policies::POLICY_TYPES as _;
-use hil_workload::demo_counting::DemoCounting as _;
-
 /// A valid experiment of demo components; `{episodes}` etc. are replaced.
 const DEMO: &str = r#"seed = 3
 episodes = EPISODES
@@ -165,12 +159,25 @@ fn huge_windows_and_session_counts_are_located_errors() {
 fn non_finite_parameters_name_the_file_line_and_field() {
     refused(&paper(&[("ALPHA", "inf")]), "policy.alpha", "alpha");
     refused(&paper(&[("ALPHA", "nan")]), "policy.alpha", "alpha");
+    // Every built-in policy, with its own fields.
+    for ty in hil_policies::POLICY_TYPES {
+        let mut table = format!("type = \"{ty}\"\nalpha = inf\n");
+        for (key, value) in hil_policies::example_fields(ty).unwrap() {
+            table.push_str(&format!("{key} = {value}\n"));
+        }
+        let text = paper(&[]).replace("type = \"linucb_qg\"\nalpha = 0.5\nw = 0.2\n", &table);
+        assert!(text.contains(ty), "{text}");
+        refused(&text, "policy.alpha", "alpha");
+    }
     // A response time's spread inside an inline table.
-    refused(
-        &demo(&[("SIGMA", "1e308")]),
-        "channel.response_time.sigma",
-        "response_time",
-    );
+    let too_wide = (2.0 * hil_channels::simulated::MAX_SIGMA).to_string();
+    for sigma in ["1e308", "inf", too_wide.as_str()] {
+        refused(
+            &demo(&[("SIGMA", sigma)]),
+            "channel.response_time.sigma",
+            "response_time",
+        );
+    }
     // An inline component table.
     let text = paper(&[]).replace(
         "[policy]\ntype = \"linucb_qg\"\nalpha = 0.5\nw = 0.2\n",
@@ -236,4 +243,27 @@ fn parameter_errors_keep_their_variant_outside_configs() {
         HilError::InvalidParameter { value, .. } => assert!(value.len() < 2 * ECHO_CHARS),
         other => panic!("{other:?}"),
     }
+}
+
+#[test]
+fn a_synthetic_study_with_huge_counts_is_refused_before_it_is_generated() {
+    use hil_workload::synth::SynthConfig;
+    let huge = SynthConfig {
+        n_no_limitation: usize::MAX,
+        ..SynthConfig::default()
+    };
+    let e = huge.generate(1).unwrap_err();
+    assert!(
+        matches!(&e, HilError::InvalidParameter { name, .. } if name == "n_no_limitation"),
+        "{e}"
+    );
+    let slow = SynthConfig {
+        survey_time_median_s: f64::INFINITY,
+        ..SynthConfig::small(2, 1)
+    };
+    assert!(matches!(
+        slow.validate(),
+        Err(HilError::InvalidParameter { name, .. }) if name == "survey_time_median_s"
+    ));
+    SynthConfig::default().validate().unwrap();
 }

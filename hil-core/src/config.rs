@@ -155,12 +155,13 @@ pub trait PolicyConfig: std::fmt::Debug + Send + Sync {
     /// described by `ctx`.
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>>;
 
-    /// Checks the parameters that need no environment. The config loader
-    /// calls it on every component it reads ([`crate::plugin::component`]),
-    /// so a bad value is a [`ConfigError`] naming the file, line and field;
-    /// `build` must check them too (calling this is the simplest way). It
-    /// must be cheap: no I/O and nothing allocated in proportion to a count
-    /// (check counts against [`limits`]). The default accepts everything.
+    /// Checks the parameters that need no environment. A config loader
+    /// ([`ExperimentConfig::parse`]) calls it on every component it reads
+    /// and turns an error into a [`ConfigError`] naming the file, line and
+    /// field ([`ConfigError::from_error`]); `build` must check them too
+    /// (calling this is the simplest way). It must be cheap: no I/O and
+    /// nothing allocated in proportion to a count (check counts against
+    /// [`limits`]). The default accepts everything.
     fn validate(&self) -> Result<()> {
         Ok(())
     }
@@ -275,16 +276,32 @@ impl ExperimentConfig {
     /// plugin types are usable wherever built-in ones are.
     pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
         load_plugins(text, path)?;
-        // The components validate themselves as they are read (see
-        // `PolicyConfig::validate`); the experiment's own fields here.
         let cfg: Self = parse_toml(text, path)?;
-        let located = |section: &[&str], e: HilError| ConfigError::from_error(text, path, section, e);
+        let located =
+            |section: &[&str], e: HilError| ConfigError::from_error(text, path, section, e);
+        limits::check_count("episodes", cfg.episodes, limits::EPISODES)
+            .map_err(|e| located(&[], e))?;
         cfg.session
             .validate()
             .and_then(|()| check_session_limits(&cfg.session))
             .map_err(|e| located(&["session"], e))?;
-        limits::check_count("episodes", cfg.episodes, limits::EPISODES)
-            .map_err(|e| located(&[], e))?;
+        // Every component's parameters, before anything is built, so that a
+        // bad value names its line (`build` checks them again).
+        let components: [(&str, Result<()>); 5] = [
+            ("environment", cfg.environment.validate()),
+            ("policy", cfg.policy.validate()),
+            ("workload", cfg.workload.validate()),
+            (
+                "policy_workload",
+                cfg.policy_workload
+                    .as_ref()
+                    .map_or(Ok(()), |w| w.validate()),
+            ),
+            ("channel", cfg.channel.validate()),
+        ];
+        for (section, checked) in components {
+            checked.map_err(|e| located(&[section], e))?;
+        }
         Ok(cfg)
     }
 }
@@ -354,20 +371,6 @@ impl ConfigError {
         let span_start = e.span().map(|s| s.start);
         let (mut line, mut column) = span_start.map_or((0, 0), |s| line_col(text, s));
         let section = span_start.map(|s| section_at(text, s)).unwrap_or_default();
-        // A component's `validate` failed while it was read (see
-        // `crate::plugin::component`): the span is the component's table, the
-        // message names the parameter within it.
-        if let Some((name, rest)) = parameter_error(&message) {
-            let mut component = section;
-            if let Some(key) = span_start.and_then(|s| key_on_line(text, s)) {
-                component.push(key); // an inline table: `policy = { ... }`
-            }
-            if let Some(l) = find_dotted_key_line(text, &component, name) {
-                (line, column) = (l, 1);
-            }
-            let field = Some(join_path(&component, name));
-            return Self::new(path, line, column, field, &format!("invalid value {rest}"));
-        }
         // Name the field: serde names it for unknown/missing fields; otherwise
         // the span points at a key or value whose key we read from the text.
         let named = quoted_after(&message, "unknown field `")
@@ -422,14 +425,13 @@ impl ConfigError {
     pub fn from_error(text: &str, path: &Path, section: &[&str], e: HilError) -> Self {
         let message = e.to_string();
         let section: Vec<String> = section.iter().map(|s| s.to_string()).collect();
-        let (field, line) = match parameter_error(&message) {
-            Some((name, _)) => (
-                join_path(&section, name),
-                find_dotted_key_line(text, &section, name),
-            ),
-            None => (section.join("."), None),
+        let field = match parameter_error(&message) {
+            Some((name, _)) => join_path(&section, name),
+            None => section.join("."),
         };
-        let line = line
+        // From the top, so that a key inside an inline table (`policy = {
+        // alpha = inf }`) is found at the table's line.
+        let line = find_dotted_key_line(text, &[], &field)
             .or_else(|| {
                 let s: Vec<&str> = section.iter().map(String::as_str).collect();
                 find_header_line(text, &s)

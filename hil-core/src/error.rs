@@ -139,6 +139,27 @@ impl HilError {
         }
     }
 
+    /// The same error, with an [`HilError::InvalidParameter`]'s name put
+    /// under `table` (`crossover` becomes `estimator.crossover`) for a
+    /// parameter checked by the code of a nested table; other errors as
+    /// they are.
+    ///
+    /// ```
+    /// use hil_core::HilError;
+    /// let e = HilError::invalid_parameter("crossover", f64::NAN, "must be > 0").within("estimator");
+    /// assert!(matches!(e, HilError::InvalidParameter { ref name, .. } if name == "estimator.crossover"));
+    /// ```
+    pub fn within(self, table: &str) -> Self {
+        match self {
+            Self::InvalidParameter { name, value, why } => Self::InvalidParameter {
+                name: format!("{table}.{name}"),
+                value,
+                why,
+            },
+            other => other,
+        }
+    }
+
     /// Shorthand for [`HilError::State`].
     pub fn state(component: impl Into<String>, why: impl Into<String>) -> Self {
         Self::State {

@@ -79,7 +79,7 @@ impl EstimatorConfig {
     /// parameters, see [`LinearPolicyConfig::validate`]).
     pub fn validate(&self) -> Result<()> {
         crate::estimator::check_lambda(self.lambda)?;
-        self.estimator.validate()
+        self.estimator.validate().map_err(|e| e.within("estimator"))
     }
 
     /// Builds the estimator for the environment described by `ctx`,

@@ -165,7 +165,11 @@ impl SynthConfig {
         ] {
             limits::check_at_most(name, n, limits::PARTICIPANTS)?;
         }
-        limits::check_at_most("d2_missing_surveys", self.d2_missing_surveys, limits::SURVEYS)?;
+        limits::check_at_most(
+            "d2_missing_surveys",
+            self.d2_missing_surveys,
+            limits::SURVEYS,
+        )?;
         limits::check_seconds("survey_time_median_s", self.survey_time_median_s)
     }
 

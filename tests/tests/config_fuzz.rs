@@ -110,7 +110,11 @@ enum Mutation {
     /// Replace the `nth` number (mod the count) with one of [`NUMBERS`].
     Number(usize, usize),
     /// Insert `depth` nested arrays or inline tables as a value.
-    Nest { depth: usize, tables: bool, at: usize },
+    Nest {
+        depth: usize,
+        tables: bool,
+        at: usize,
+    },
     /// Insert junk bytes at `at`.
     Junk(usize, Vec<u8>),
     /// Repeat a slice of the text many times (a long value or key).
@@ -141,7 +145,13 @@ fn number_starts(text: &[u8]) -> Vec<usize> {
 }
 
 fn apply(text: &mut Vec<u8>, m: &Mutation) {
-    let at = |a: usize, text: &Vec<u8>| if text.is_empty() { 0 } else { a % (text.len() + 1) };
+    let at = |a: usize, text: &Vec<u8>| {
+        if text.is_empty() {
+            0
+        } else {
+            a % (text.len() + 1)
+        }
+    };
     match m {
         Mutation::Truncate(a) => {
             let cut = at(*a, text);
@@ -164,13 +174,21 @@ fn apply(text: &mut Vec<u8>, m: &Mutation) {
                 .unwrap_or(text.len());
             text.splice(s..end, NUMBERS[*v].bytes());
         }
-        Mutation::Nest { depth, tables, at: a } => {
+        Mutation::Nest {
+            depth,
+            tables,
+            at: a,
+        } => {
             let (open, close) = if *tables {
                 ("{ a = ", " }")
             } else {
                 ("[", "]")
             };
-            let value = format!("\nnest = {}1{}\n", open.repeat(*depth), close.repeat(*depth));
+            let value = format!(
+                "\nnest = {}1{}\n",
+                open.repeat(*depth),
+                close.repeat(*depth)
+            );
             let i = at(*a, text);
             text.splice(i..i, value.bytes());
         }

@@ -103,7 +103,11 @@ fn refused(text: &str, field: &str, key: &str) -> ConfigError {
     assert_eq!(e.field.as_deref(), Some(field), "{e}");
     assert_eq!(e.line, line_of(text, key), "{e}");
     // Whatever was echoed, the message stays short.
-    assert!(e.to_string().len() < 8 * ECHO_CHARS, "{} bytes", e.to_string().len());
+    assert!(
+        e.to_string().len() < 8 * ECHO_CHARS,
+        "{} bytes",
+        e.to_string().len()
+    );
     e
 }
 
@@ -127,7 +131,13 @@ fn huge_episode_counts_are_located_errors() {
 
 #[test]
 fn huge_items_per_episode_are_located_errors() {
-    for n in ["9223372036854775807", "4294967296", "1000000000000", "1e12", "0"] {
+    for n in [
+        "9223372036854775807",
+        "4294967296",
+        "1000000000000",
+        "1e12",
+        "0",
+    ] {
         refused(
             &paper(&[("ITEMS", n)]),
             "environment.items_per_episode",
@@ -148,7 +158,11 @@ fn a_huge_demo_plate_is_a_located_error() {
 
 #[test]
 fn huge_windows_and_session_counts_are_located_errors() {
-    refused(&demo(&[("WINDOW", "1000000000000")]), "workload.window", "window");
+    refused(
+        &demo(&[("WINDOW", "1000000000000")]),
+        "workload.window",
+        "window",
+    );
     refused(&demo(&[("WINDOW", "0")]), "workload.window", "window");
     refused(&demo(&[("N_ATT", "4294967295")]), "session.n_att", "n_att");
     let text = demo(&[("N_ATT", "3\nmax_items = 9223372036854775807")]);
@@ -159,6 +173,12 @@ fn huge_windows_and_session_counts_are_located_errors() {
 fn non_finite_parameters_name_the_file_line_and_field() {
     refused(&paper(&[("ALPHA", "inf")]), "policy.alpha", "alpha");
     refused(&paper(&[("ALPHA", "nan")]), "policy.alpha", "alpha");
+    // A nested table's parameter.
+    let text = paper(&[]).replace(
+        "w = 0.2\n",
+        "w = 0.2\n[policy.estimator]\ncrossover = nan\n",
+    );
+    refused(&text, "policy.estimator.crossover", "crossover");
     // Every built-in policy, with its own fields.
     for ty in hil_policies::POLICY_TYPES {
         let mut table = format!("type = \"{ty}\"\nalpha = inf\n");
@@ -179,10 +199,7 @@ fn non_finite_parameters_name_the_file_line_and_field() {
         );
     }
     // An inline component table.
-    let text = paper(&[]).replace(
-        "[policy]\ntype = \"linucb_qg\"\nalpha = 0.5\nw = 0.2\n",
-        "",
-    );
+    let text = paper(&[]).replace("[policy]\ntype = \"linucb_qg\"\nalpha = 0.5\nw = 0.2\n", "");
     let text = format!("policy = {{ type = \"linucb_qg\", alpha = inf, w = 0.2 }}\n{text}");
     refused(&text, "policy.alpha", "policy");
 }

@@ -86,8 +86,6 @@ pub trait KindOf {
     const KIND: ComponentKind;
     /// Wraps a plugin component as a config of this kind.
     fn from_plugin(c: PluginComponent) -> Box<Self>;
-    /// The config's own `validate` (e.g. [`PolicyConfig::validate`]).
-    fn validate_config(&self) -> Result<()>;
 }
 
 macro_rules! kind_of {
@@ -96,9 +94,6 @@ macro_rules! kind_of {
             const KIND: ComponentKind = ComponentKind::$kind;
             fn from_plugin(c: PluginComponent) -> Box<Self> {
                 Box::new(c)
-            }
-            fn validate_config(&self) -> Result<()> {
-                $t::validate(self)
             }
         }
     };
@@ -113,8 +108,6 @@ kind_of!(QueryChannelConfig, QueryChannel);
 /// `#[serde(deserialize_with = "hil_core::plugin::component")]` on a
 /// `Box<dyn PolicyConfig>` (or any of the four) field of a config file of
 /// your own, so that plugin types work there as in [`crate::ExperimentConfig`].
-/// A built-in type's parameters are checked as it is read (its
-/// `validate`, e.g. [`PolicyConfig::validate`]).
 pub fn component<'de, D, T>(d: D) -> std::result::Result<Box<T>, D::Error>
 where
     D: Deserializer<'de>,
@@ -137,7 +130,7 @@ where
         let name = name_of(&mut params);
         return Ok(T::from_plugin(PluginComponent { name, params }));
     }
-    let config = Box::<T>::deserialize(value).map_err(|e| {
+    Box::<T>::deserialize(value).map_err(|e| {
         let msg = e.message().trim().to_string();
         match (msg.strip_prefix("unknown variant `"), ty.as_deref()) {
             (Some(_), Some(name)) => {
@@ -150,11 +143,7 @@ where
             }
             _ => D::Error::custom(msg),
         }
-    })?;
-    // Checked as it is read, so that the config loader names the file, line
-    // and field of a bad parameter (it recognises the message's form).
-    config.validate_config().map_err(D::Error::custom)?;
-    Ok(config)
+    })
 }
 
 /// [`component`] for an optional field.

@@ -25,6 +25,12 @@
 //!
 //! Crates register built-in types with `#[typetag::serde(name = "...")]` on
 //! an `impl PolicyConfig for ...` (or the other three config traits).
+//!
+//! [`ExperimentConfig::parse`] checks the whole file before anything is
+//! built: every count against the limits stated in [`limits`], and every
+//! component's parameters through its config's `validate`. Any error is a
+//! [`ConfigError`] naming the file, line and field, and quotes an offending
+//! value shortened by [`crate::error::echo`].
 
 pub mod limits;
 
@@ -236,7 +242,8 @@ pub struct ExperimentConfig {
     /// Master seed; episode `k` runs with a seed derived from it.
     #[serde(default)]
     pub seed: u64,
-    /// Number of episodes (the policy keeps learning across them).
+    /// Number of episodes (the policy keeps learning across them), 1 to
+    /// [`limits::EPISODES`].
     #[serde(default = "one")]
     pub episodes: usize,
     /// Session-loop settings.

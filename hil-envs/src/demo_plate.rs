@@ -40,7 +40,8 @@ pub struct DemoPlateConfig {
     /// Foods on the plate, in order (names from the feeding data, see
     /// [`DemoPlate::foods`]).
     pub foods: Vec<String>,
-    /// How many times the list is served (default 1).
+    /// How many times the list is served (default 1); foods × repeat is at
+    /// most [`limits::ITEMS_PER_EPISODE`].
     #[serde(default = "one")]
     pub repeat: usize,
 }

@@ -336,7 +336,8 @@ pub struct FoodReplayConfig {
     /// Foods whose data is offered for pretraining (none if empty).
     #[serde(default)]
     pub pretrain_foods: Vec<String>,
-    /// Items per episode.
+    /// Items per episode (default 5, at most
+    /// [`limits::ITEMS_PER_EPISODE`]).
     #[serde(default = "default_items")]
     pub items_per_episode: usize,
     /// How outcomes are decided.

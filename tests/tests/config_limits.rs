@@ -254,6 +254,12 @@ fn parameter_errors_keep_their_variant_outside_configs() {
         matches!(&e, HilError::InvalidParameter { name, .. } if name == "repeat"),
         "{e}"
     );
+    let ds = hil_envs::bundled_dataset().unwrap();
+    let e = hil_envs::DatasetReplayEnv::new(ds, &["banana".into()], usize::MAX).unwrap_err();
+    assert!(
+        matches!(&e, HilError::InvalidParameter { name, .. } if name == "items_per_episode"),
+        "{e}"
+    );
     let long = "y".repeat(100_000);
     let e = HilError::invalid_parameter("foods", &long, "unknown food");
     match e {
@@ -283,4 +289,16 @@ fn a_synthetic_study_with_huge_counts_is_refused_before_it_is_generated() {
         Err(HilError::InvalidParameter { name, .. }) if name == "survey_time_median_s"
     ));
     SynthConfig::default().validate().unwrap();
+}
+
+#[test]
+fn an_experiment_built_in_code_checks_its_episodes_before_allocating() {
+    let cfg = ExperimentConfig::parse(&demo(&[]), Path::new("demo.toml")).unwrap();
+    let mut experiment = cfg.build(Path::new(".")).unwrap();
+    experiment.episodes = usize::MAX;
+    let e = experiment.run(&mut [], |_, _| {}).unwrap_err();
+    assert!(
+        matches!(&e, HilError::InvalidParameter { name, .. } if name == "episodes"),
+        "{e}"
+    );
 }

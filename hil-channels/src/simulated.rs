@@ -8,39 +8,40 @@ use rand_distr::{Distribution, LogNormal};
 use serde::{Deserialize, Serialize};
 
 use hil_core::channel::PerfectExpert;
-use hil_core::config::QueryChannelConfig;
+use hil_core::config::{QueryChannelConfig, limits};
 use hil_core::session::splitmix;
 use hil_core::{
     Answer, ArmId, BoundingBox, BuildContext, HilError, Query, QueryChannel, Response,
     ResponseType, Result,
 };
 
+/// Largest log-space spread of simulated response times: with it, a draw
+/// 30 standard deviations out from a one-day median is still finite.
+pub const MAX_SIGMA: f64 = 10.0;
+
 /// How long a simulated person takes to answer: log-normal with the given
 /// median and log-space spread (`sigma = 0` gives a fixed time).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ResponseTimeModel {
-    /// Median response time in seconds (> 0).
+    /// Median response time in seconds, in (0, [`limits::SECONDS`]].
     pub median_s: f64,
-    /// Standard deviation of the log response time (>= 0).
+    /// Standard deviation of the log response time, in [0, [`MAX_SIGMA`]].
     #[serde(default)]
     pub sigma: f64,
 }
 
 impl ResponseTimeModel {
     fn validate(&self) -> Result<()> {
-        if !(self.median_s.is_finite() && self.median_s > 0.0) {
-            return Err(HilError::invalid_parameter(
-                "response_time.median_s",
-                self.median_s,
-                "must be a positive number of seconds",
-            ));
-        }
-        if !(self.sigma.is_finite() && self.sigma >= 0.0) {
+        limits::check_seconds("response_time.median_s", self.median_s)?;
+        // A log-space spread beyond a few units makes a day-long median
+        // answer in seconds or in millennia; beyond MAX_SIGMA a draw can
+        // overflow to an infinite time.
+        if !(self.sigma.is_finite() && (0.0..=MAX_SIGMA).contains(&self.sigma)) {
             return Err(HilError::invalid_parameter(
                 "response_time.sigma",
                 self.sigma,
-                "must be finite and non-negative",
+                format!("must be a number in [0, {MAX_SIGMA}]"),
             ));
         }
         Ok(())
@@ -109,6 +110,10 @@ impl SimulatedExpertConfig {
 impl QueryChannelConfig for SimulatedExpertConfig {
     fn build(&self, _ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
         Ok(Box::new(SimulatedExpert::new(self.clone())?))
+    }
+
+    fn validate(&self) -> Result<()> {
+        SimulatedExpertConfig::validate(self)
     }
 }
 

@@ -25,6 +25,14 @@
 //!
 //! Crates register built-in types with `#[typetag::serde(name = "...")]` on
 //! an `impl PolicyConfig for ...` (or the other three config traits).
+//!
+//! [`ExperimentConfig::parse`] checks the whole file before anything is
+//! built: every count against the limits stated in [`limits`], and every
+//! component's parameters through its config's `validate`. Any error is a
+//! [`ConfigError`] naming the file, line and field, and quotes an offending
+//! value shortened by [`crate::error::echo`].
+
+pub mod limits;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -35,7 +43,7 @@ use crate::action::ActionSpace;
 use crate::channel::QueryChannel;
 use crate::decision::LabelledObservation;
 use crate::environment::Environment;
-use crate::error::Result;
+use crate::error::{HilError, Result, echo};
 use crate::policy::Policy;
 use crate::session::SessionSettings;
 use crate::workload::WorkloadModel;
@@ -153,6 +161,17 @@ pub trait PolicyConfig: std::fmt::Debug + Send + Sync {
     /// described by `ctx`.
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>>;
 
+    /// Checks the parameters that need no environment. A config loader
+    /// ([`ExperimentConfig::parse`]) calls it on every component it reads
+    /// and turns an error into a [`ConfigError`] naming the file, line and
+    /// field ([`ConfigError::from_error`]); `build` must check them too
+    /// (calling this is the simplest way). It must be cheap: no I/O and
+    /// nothing allocated in proportion to a count (check counts against
+    /// [`limits`]). The default accepts everything.
+    fn validate(&self) -> Result<()> {
+        Ok(())
+    }
+
     /// Whether the policy's decisions read the workload forecast. A protocol
     /// runs a policy that does not once and scores it under every workload
     /// model; one that does runs once per deciding model. The default
@@ -175,6 +194,11 @@ pub trait EnvironmentConfig: std::fmt::Debug + Send + Sync {
     /// Validates the parameters and builds the environment.
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Environment>>;
 
+    /// Checks the parameters at load time; see [`PolicyConfig::validate`].
+    fn validate(&self) -> Result<()> {
+        Ok(())
+    }
+
     /// Offline data for pretraining policies (e.g. the pretraining foods of
     /// a dataset), handed to policy configs through
     /// [`BuildContext::pretraining`]. None by default.
@@ -189,6 +213,11 @@ pub trait EnvironmentConfig: std::fmt::Debug + Send + Sync {
 pub trait WorkloadModelConfig: std::fmt::Debug + Send + Sync {
     /// Validates the parameters and builds (or loads) the model.
     fn build(&self, ctx: &BuildContext) -> Result<Arc<dyn WorkloadModel>>;
+
+    /// Checks the parameters at load time; see [`PolicyConfig::validate`].
+    fn validate(&self) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// A serialisable recipe for a [`QueryChannel`].
@@ -196,6 +225,11 @@ pub trait WorkloadModelConfig: std::fmt::Debug + Send + Sync {
 pub trait QueryChannelConfig: std::fmt::Debug + Send + Sync {
     /// Validates the parameters and builds the channel.
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn QueryChannel>>;
+
+    /// Checks the parameters at load time; see [`PolicyConfig::validate`].
+    fn validate(&self) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// A complete experiment: the components and how to run them.
@@ -208,7 +242,8 @@ pub struct ExperimentConfig {
     /// Master seed; episode `k` runs with a seed derived from it.
     #[serde(default)]
     pub seed: u64,
-    /// Number of episodes (the policy keeps learning across them).
+    /// Number of episodes (the policy keeps learning across them), 1 to
+    /// [`limits::EPISODES`].
     #[serde(default = "one")]
     pub episodes: usize,
     /// Session-loop settings.
@@ -249,19 +284,45 @@ impl ExperimentConfig {
     pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
         load_plugins(text, path)?;
         let cfg: Self = parse_toml(text, path)?;
+        let located =
+            |section: &[&str], e: HilError| ConfigError::from_error(text, path, section, e);
+        limits::check_count("episodes", cfg.episodes, limits::EPISODES)
+            .map_err(|e| located(&[], e))?;
         cfg.session
             .validate()
-            .map_err(|e| ConfigError::at_key(text, path, &["session"], e.to_string()))?;
-        if cfg.episodes == 0 {
-            return Err(ConfigError::at_key(
-                text,
-                path,
-                &["episodes"],
-                "must be at least 1".into(),
-            ));
+            .and_then(|()| check_session_limits(&cfg.session))
+            .map_err(|e| located(&["session"], e))?;
+        // Every component's parameters, before anything is built, so that a
+        // bad value names its line (`build` checks them again).
+        let components: [(&str, Result<()>); 5] = [
+            ("environment", cfg.environment.validate()),
+            ("policy", cfg.policy.validate()),
+            ("workload", cfg.workload.validate()),
+            (
+                "policy_workload",
+                cfg.policy_workload
+                    .as_ref()
+                    .map_or(Ok(()), |w| w.validate()),
+            ),
+            ("channel", cfg.channel.validate()),
+        ];
+        for (section, checked) in components {
+            checked.map_err(|e| located(&[section], e))?;
         }
         Ok(cfg)
     }
+}
+
+/// Checks the counts of session settings against [`limits`]
+/// (`n_att` ≤ [`limits::ATTEMPTS_PER_ITEM`], `max_items` ≤
+/// [`limits::ITEMS_PER_EPISODE`]); every loader of session settings calls it
+/// after [`SessionSettings::validate`].
+pub fn check_session_limits(settings: &SessionSettings) -> Result<()> {
+    limits::check_count("n_att", settings.n_att, limits::ATTEMPTS_PER_ITEM)?;
+    if let Some(n) = settings.max_items {
+        limits::check_count("max_items", n, limits::ITEMS_PER_EPISODE)?;
+    }
+    Ok(())
 }
 
 /// Loads the `plugins` a config file lists (a top-level `plugins` array),
@@ -315,12 +376,12 @@ impl ConfigError {
     fn from_toml(text: &str, path: &Path, e: &toml::de::Error) -> Self {
         let message = e.message().trim().to_string();
         let span_start = e.span().map(|s| s.start);
+        let (mut line, mut column) = span_start.map_or((0, 0), |s| line_col(text, s));
+        let section = span_start.map(|s| section_at(text, s)).unwrap_or_default();
         // Name the field: serde names it for unknown/missing fields; otherwise
         // the span points at a key or value whose key we read from the text.
         let named = quoted_after(&message, "unknown field `")
             .or_else(|| quoted_after(&message, "missing field `"));
-        let (mut line, mut column) = span_start.map_or((0, 0), |s| line_col(text, s));
-        let section = span_start.map(|s| section_at(text, s)).unwrap_or_default();
         let field = match (&named, span_start) {
             (Some(name), _) => {
                 // typetag buffers a table and reports at its header: find the key.
@@ -351,13 +412,44 @@ impl ConfigError {
         if message.starts_with("unknown variant") && field.is_none() {
             column = column.max(1);
         }
-        Self {
-            path: path.to_path_buf(),
-            line,
-            column,
-            field,
-            message,
-        }
+        Self::new(path, line, column, field, &message)
+    }
+
+    /// The error `e` raised by validating the table at `section` of a config
+    /// (`&[]` for the top level): an [`HilError::InvalidParameter`] is
+    /// located at its parameter's key (a dotted name such as
+    /// `response_time.sigma` is followed into nested tables), anything else
+    /// at the section.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use hil_core::{ConfigError, HilError};
+    /// let text = "[session]\nn_att = 0\n";
+    /// let e = HilError::invalid_parameter("n_att", 0, "must be at least 1");
+    /// let c = ConfigError::from_error(text, Path::new("x.toml"), &["session"], e);
+    /// assert_eq!((c.line, c.field.as_deref()), (2, Some("session.n_att")));
+    /// ```
+    pub fn from_error(text: &str, path: &Path, section: &[&str], e: HilError) -> Self {
+        let message = e.to_string();
+        let section: Vec<String> = section.iter().map(|s| s.to_string()).collect();
+        let field = match parameter_error(&message) {
+            Some((name, _)) => join_path(&section, name),
+            None => section.join("."),
+        };
+        // From the top, so that a key inside an inline table (`policy = {
+        // alpha = inf }`) is found at the table's line.
+        let line = find_dotted_key_line(text, &[], &field)
+            .or_else(|| {
+                let s: Vec<&str> = section.iter().map(String::as_str).collect();
+                find_header_line(text, &s)
+            })
+            .unwrap_or(0);
+        let message = match parameter_error(&message) {
+            Some((_, rest)) => format!("invalid value {rest}"),
+            None => message,
+        };
+        let field = (!field.is_empty()).then_some(field);
+        Self::new(path, line, usize::from(line > 0), field, &message)
     }
 
     /// An error about the key at `key_path` (e.g. `["policy", "alpha"]`).
@@ -369,14 +461,79 @@ impl ConfigError {
         let line = find_key_line(text, &section, key)
             .or_else(|| find_header_line(text, key_path))
             .unwrap_or(0);
+        Self::new(
+            path,
+            line,
+            if line > 0 { 1 } else { 0 },
+            Some(key_path.join(".")),
+            &message,
+        )
+    }
+
+    /// Every constructor ends here: the field and any value the message
+    /// quotes are shortened by [`echo`], so a 100 KB key or value never
+    /// becomes a 100 KB message.
+    fn new(path: &Path, line: usize, column: usize, field: Option<String>, message: &str) -> Self {
         Self {
             path: path.to_path_buf(),
             line,
-            column: if line > 0 { 1 } else { 0 },
-            field: Some(key_path.join(".")),
-            message,
+            column,
+            field: field.map(|f| echo(&f).into_owned()),
+            message: echo_quoted(message),
         }
     }
+}
+
+/// The prefix of [`HilError::InvalidParameter`]'s message.
+const PARAMETER_PREFIX: &str = "invalid parameter `";
+
+/// The parameter an [`HilError::InvalidParameter`] message names, and the
+/// message from its value on (`invalid value 0: must be ...`).
+fn parameter_error(message: &str) -> Option<(&str, &str)> {
+    let rest = message.strip_prefix(PARAMETER_PREFIX)?;
+    let (name, rest) = rest.split_once('`')?;
+    let rest = rest.strip_prefix(" = ").unwrap_or(rest);
+    Some((name, rest))
+}
+
+/// `message` with every `` `quoted` `` or `"quoted"` part shortened by
+/// [`echo`]; a message still longer than a few values (unbalanced quotes) is
+/// shortened as a whole.
+fn echo_quoted(message: &str) -> String {
+    let mut out = String::with_capacity(message.len().min(1024));
+    let mut rest = message;
+    while let Some(open) = rest.find(['`', '"']) {
+        let quote = &rest[open..open + 1];
+        let Some(len) = rest[open + 1..].find(quote) else {
+            break;
+        };
+        let inner = &rest[open + 1..open + 1 + len];
+        out.push_str(&rest[..=open]);
+        out.push_str(&echo(inner));
+        out.push_str(quote);
+        rest = &rest[open + 2 + len..];
+    }
+    out.push_str(rest);
+    if out.chars().count() > 8 * crate::error::ECHO_CHARS {
+        let cut = out
+            .char_indices()
+            .nth(8 * crate::error::ECHO_CHARS)
+            .map_or(out.len(), |(i, _)| i);
+        out = format!("{}… ({} bytes)", &out[..cut], message.len());
+    }
+    out
+}
+
+/// The line of the dotted key `name` (`response_time.sigma`) under
+/// `section`, whether its parts are written as tables or an inline table:
+/// the line of the deepest part found.
+fn find_dotted_key_line(text: &str, section: &[String], name: &str) -> Option<usize> {
+    let parts: Vec<&str> = name.split('.').collect();
+    (0..parts.len()).rev().find_map(|i| {
+        let mut s = section.to_vec();
+        s.extend(parts[..i].iter().map(|p| p.to_string()));
+        find_key_line(text, &s, parts[i])
+    })
 }
 
 fn quoted_after(msg: &str, prefix: &str) -> Option<String> {
@@ -488,11 +645,18 @@ fn find_value_line(text: &str, section: &[String], literal: &str) -> Option<(usi
             .unwrap_or("")
             .trim();
         let normalised = value.replace('\'', "\"");
-        if value == literal || normalised == literal {
+        if value == literal || normalised == literal || same_number(value, literal) {
             return Some((i + 1, key));
         }
     }
     None
+}
+
+/// Whether two number literals have the same value (`1e12` written,
+/// `1000000000000.0` quoted by serde).
+fn same_number(written: &str, quoted: &str) -> bool {
+    let number = |s: &str| s.replace('_', "").parse::<f64>().ok();
+    matches!((number(written), number(quoted)), (Some(a), Some(b)) if a == b)
 }
 
 fn find_header_line(text: &str, section: &[&str]) -> Option<usize> {

@@ -3,6 +3,7 @@
 //! Variants are structured (like faer's errors) so that callers can react to
 //! the kind of failure, and every message names what was wrong and where.
 
+use std::borrow::Cow;
 use std::path::PathBuf;
 
 /// Result alias used across hil.
@@ -124,7 +125,8 @@ impl HilError {
         }
     }
 
-    /// Shorthand for [`HilError::InvalidParameter`].
+    /// Shorthand for [`HilError::InvalidParameter`]; the value is shortened
+    /// by [`echo`].
     pub fn invalid_parameter(
         name: impl Into<String>,
         value: impl std::fmt::Display,
@@ -132,8 +134,29 @@ impl HilError {
     ) -> Self {
         Self::InvalidParameter {
             name: name.into(),
-            value: value.to_string(),
+            value: echo(&value.to_string()).into_owned(),
             why: why.into(),
+        }
+    }
+
+    /// The same error, with an [`HilError::InvalidParameter`]'s name put
+    /// under `table` (`crossover` becomes `estimator.crossover`) for a
+    /// parameter checked by the code of a nested table; other errors as
+    /// they are.
+    ///
+    /// ```
+    /// use hil_core::HilError;
+    /// let e = HilError::invalid_parameter("crossover", f64::NAN, "must be > 0").within("estimator");
+    /// assert!(matches!(e, HilError::InvalidParameter { ref name, .. } if name == "estimator.crossover"));
+    /// ```
+    pub fn within(self, table: &str) -> Self {
+        match self {
+            Self::InvalidParameter { name, value, why } => Self::InvalidParameter {
+                name: format!("{table}.{name}"),
+                value,
+                why,
+            },
+            other => other,
         }
     }
 
@@ -160,5 +183,28 @@ impl HilError {
             path: path.into(),
             source,
         }
+    }
+}
+
+/// Most characters of an offending value that an error message repeats.
+pub const ECHO_CHARS: usize = 64;
+
+/// `value` as an error message repeats it: whole if it has at most
+/// [`ECHO_CHARS`] characters, else its first [`ECHO_CHARS`] characters and
+/// its length, so a 100 KB value in a config never becomes a 100 KB
+/// message. Every error that quotes a value it was given goes through this.
+///
+/// ```
+/// use hil_core::error::echo;
+/// assert_eq!(echo("0.5"), "0.5");
+/// let long = "x".repeat(100_000);
+/// let shown = echo(&long);
+/// assert!(shown.starts_with("xxxx") && shown.ends_with("(100000 bytes)"));
+/// assert!(shown.len() < 100);
+/// ```
+pub fn echo(value: &str) -> Cow<'_, str> {
+    match value.char_indices().nth(ECHO_CHARS) {
+        None => Cow::Borrowed(value),
+        Some((cut, _)) => Cow::Owned(format!("{}… ({} bytes)", &value[..cut], value.len())),
     }
 }

@@ -115,6 +115,13 @@ impl Experiment {
         observers: &mut [&mut dyn SessionObserver],
         mut on_episode: impl FnMut(usize, &EpisodeReport),
     ) -> Result<ExperimentSummary> {
+        // An experiment built in code skips the config's check: repeat it
+        // before the allocation it bounds.
+        crate::config::limits::check_count(
+            "episodes",
+            self.episodes,
+            crate::config::limits::EPISODES,
+        )?;
         let mut metrics = Vec::with_capacity(self.episodes);
         for k in 0..self.episodes {
             let seed = self.episode_seed(k);

@@ -185,9 +185,14 @@ fn wrong_value_type_names_the_field() {
 
 #[test]
 fn invalid_values_are_reported_at_their_key() {
-    let e = parse(&GOOD.replace("wl0 = 0.4", "wl0 = 1.5")).unwrap_err();
-    assert_eq!(e.field.as_deref(), Some("session"), "{e}");
-    assert!(e.to_string().contains("wl0"), "{e}");
+    let text = GOOD.replace("wl0 = 0.4", "wl0 = 1.5");
+    let e = parse(&text).unwrap_err();
+    let line = text.lines().position(|l| l.starts_with("wl0")).unwrap() + 1;
+    assert_eq!(
+        (e.line, e.field.as_deref()),
+        (line, Some("session.wl0")),
+        "{e}"
+    );
     let e = parse(&GOOD.replace("episodes = 2", "episodes = 0")).unwrap_err();
     assert_eq!((e.line, e.field.as_deref()), (3, Some("episodes")), "{e}");
 }

@@ -10,7 +10,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use hil_core::config::EnvironmentConfig;
+use hil_core::config::{EnvironmentConfig, limits};
 use hil_core::{
     ActionSpace, ArmId, BuildContext, CallOrder, Context, Environment, HilError, Item, Outcome,
     Result,
@@ -40,7 +40,8 @@ pub struct DemoPlateConfig {
     /// Foods on the plate, in order (names from the feeding data, see
     /// [`DemoPlate::foods`]).
     pub foods: Vec<String>,
-    /// How many times the list is served (default 1).
+    /// How many times the list is served (default 1); foods × repeat is at
+    /// most [`limits::ITEMS_PER_EPISODE`].
     #[serde(default = "one")]
     pub repeat: usize,
 }
@@ -53,6 +54,10 @@ fn one() -> usize {
 impl EnvironmentConfig for DemoPlateConfig {
     fn build(&self, _ctx: &BuildContext) -> Result<Box<dyn Environment>> {
         Ok(Box::new(DemoPlate::new(&self.foods, self.repeat)?))
+    }
+
+    fn validate(&self) -> Result<()> {
+        DemoPlate::check(&self.foods, self.repeat).map(drop)
     }
 }
 
@@ -93,39 +98,18 @@ impl DemoPlate {
         FeedingTask::bundled().food_names()
     }
 
-    /// A plate serving `foods` (names from [`DemoPlate::foods`]) `repeat` times.
+    /// A plate serving `foods` (names from [`DemoPlate::foods`]) `repeat`
+    /// times: at most [`limits::ITEMS_PER_EPISODE`] items in all.
     pub fn new(foods: &[String], repeat: usize) -> Result<Self> {
-        if foods.is_empty() || repeat == 0 {
-            return Err(HilError::invalid_parameter(
-                "foods",
-                format!("{foods:?} × {repeat}"),
-                "the plate needs at least one food, served at least once",
-            ));
-        }
         let task = FeedingTask::bundled();
-        let mut order = Vec::new();
+        let once = Self::check(foods, repeat)?;
         let mut types = Vec::new();
-        for f in foods {
-            let idx = task
-                .foods
-                .iter()
-                .position(|k| &k.name == f)
-                .ok_or_else(|| {
-                    HilError::invalid_parameter(
-                        "foods",
-                        f,
-                        format!("unknown food; choose from {:?}", Self::foods()),
-                    )
-                })?;
+        for &idx in &once {
             if !types.contains(&idx) {
                 types.push(idx);
             }
-            order.push(idx);
         }
-        let once = order.clone();
-        for _ in 1..repeat {
-            order.extend_from_slice(&once);
-        }
+        let order = once.repeat(repeat);
         Ok(Self {
             task,
             types,
@@ -135,6 +119,35 @@ impl DemoPlate {
             current: None,
             calls: CallOrder::new("demo_plate"),
         })
+    }
+
+    /// Checks a plate against the limits before anything proportional to
+    /// `repeat` is allocated; returns the foods' indices, once through.
+    fn check(foods: &[String], repeat: usize) -> Result<Vec<usize>> {
+        if foods.is_empty() {
+            return Err(HilError::invalid_parameter(
+                "foods",
+                "[]",
+                "the plate needs at least one food",
+            ));
+        }
+        limits::check_count("foods", foods.len(), limits::ITEMS_PER_EPISODE)?;
+        // The plate serves foods × repeat items.
+        let max_repeat = limits::ITEMS_PER_EPISODE / foods.len() as u64;
+        limits::check_count("repeat", repeat, max_repeat)?;
+        let task = FeedingTask::bundled();
+        foods
+            .iter()
+            .map(|f| {
+                task.foods.iter().position(|k| &k.name == f).ok_or_else(|| {
+                    HilError::invalid_parameter(
+                        "foods",
+                        f,
+                        format!("unknown food; choose from {:?}", Self::foods()),
+                    )
+                })
+            })
+            .collect()
     }
 
     fn food(&self) -> Result<&'static FoodFacts> {

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use hil_core::config::{BuildContext, EnvironmentConfig};
+use hil_core::config::{BuildContext, EnvironmentConfig, limits};
 use hil_core::session::splitmix;
 use hil_core::{
     ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, LabelledObservation,
@@ -70,21 +70,16 @@ pub struct DatasetReplayEnv {
 }
 
 impl DatasetReplayEnv {
-    /// An environment presenting `items_per_episode` items drawn uniformly
-    /// (with replacement) from `foods` of `dataset`.
+    /// An environment presenting `items_per_episode` items (at most
+    /// [`limits::ITEMS_PER_EPISODE`]) drawn uniformly (with replacement) from
+    /// `foods` of `dataset`.
     pub fn new(
         dataset: Arc<FoodDataset>,
         foods: &[String],
         items_per_episode: usize,
     ) -> Result<Self> {
+        check_items(items_per_episode)?;
         check_disjoint(&[("foods", foods)], &dataset)?;
-        if items_per_episode == 0 {
-            return Err(HilError::invalid_parameter(
-                "items_per_episode",
-                0,
-                "must be at least 1",
-            ));
-        }
         let foods = foods
             .iter()
             .map(|f| dataset.food_index(f).expect("checked above"))
@@ -341,7 +336,8 @@ pub struct FoodReplayConfig {
     /// Foods whose data is offered for pretraining (none if empty).
     #[serde(default)]
     pub pretrain_foods: Vec<String>,
-    /// Items per episode.
+    /// Items per episode (default 5, at most
+    /// [`limits::ITEMS_PER_EPISODE`]).
     #[serde(default = "default_items")]
     pub items_per_episode: usize,
     /// How outcomes are decided.
@@ -354,6 +350,16 @@ pub struct FoodReplayConfig {
 
 fn default_items() -> usize {
     5
+}
+
+/// The one check of an episode's item count: it sizes the episode's
+/// sequence, so it is bounded by [`limits::ITEMS_PER_EPISODE`].
+fn check_items(items_per_episode: usize) -> Result<()> {
+    limits::check_count(
+        "items_per_episode",
+        items_per_episode,
+        limits::ITEMS_PER_EPISODE,
+    )
 }
 
 impl FoodReplayConfig {
@@ -379,6 +385,10 @@ impl EnvironmentConfig for FoodReplayConfig {
             DatasetReplayEnv::new(ds, &self.foods, self.items_per_episode)?
                 .with_outcomes(self.outcomes)?,
         ))
+    }
+
+    fn validate(&self) -> Result<()> {
+        check_items(self.items_per_episode)
     }
 
     fn pretraining(&self, ctx: &BuildContext) -> Result<Option<Arc<[LabelledObservation]>>> {

@@ -75,6 +75,13 @@ impl EstimatorConfig {
             .map_err(|e| HilError::serde("policy config", e.message().trim()))
     }
 
+    /// Checks λ and the estimator options (α is checked by each policy's
+    /// parameters, see [`LinearPolicyConfig::validate`]).
+    pub fn validate(&self) -> Result<()> {
+        crate::estimator::check_lambda(self.lambda)?;
+        self.estimator.validate().map_err(|e| e.within("estimator"))
+    }
+
     /// Builds the estimator for the environment described by `ctx`,
     /// pretrained on its offline data if `pretrain` is set.
     pub fn build_estimator(&self, ctx: &BuildContext) -> Result<LinearArms> {
@@ -156,6 +163,14 @@ pub struct LinearPolicyConfig<F> {
 }
 
 impl<F: RuleConfig> LinearPolicyConfig<F> {
+    /// Checks every parameter that needs no environment (α, the policy's
+    /// own fields, λ, the estimator options); the config loader calls it as
+    /// the table is read, so errors name the file, line and field.
+    pub fn validate(&self) -> Result<()> {
+        self.rule.params(self.common.alpha, self.query_kind)?;
+        self.common.validate()
+    }
+
     /// Validates the parameters and builds the policy, seeded with the
     /// config's seed if it has one, else the experiment seed.
     pub fn build_policy(&self, ctx: &BuildContext) -> Result<LinearPolicy<F::Rule>> {
@@ -264,6 +279,9 @@ macro_rules! register {
                 ctx: &hil_core::BuildContext,
             ) -> hil_core::Result<Box<dyn hil_core::Policy>> {
                 Ok(Box::new(self.build_policy(ctx)?))
+            }
+            fn validate(&self) -> hil_core::Result<()> {
+                $crate::config::LinearPolicyConfig::validate(self)
             }
             fn uses_workload_forecast(&self) -> bool {
                 <$fields as $crate::config::RuleConfig>::USES_WORKLOAD_FORECAST

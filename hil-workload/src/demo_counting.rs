@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use hil_core::config::WorkloadModelConfig;
+use hil_core::config::{WorkloadModelConfig, limits};
 use hil_core::{BuildContext, HilError, QueryHistory, Result, Timestep, WorkloadModel};
 
 /// Config of the demo workload model, `type = "demo_counting"`:
@@ -35,13 +35,19 @@ use hil_core::{BuildContext, HilError, QueryHistory, Result, Timestep, WorkloadM
 pub struct DemoCounting {
     /// Workload added per query in the window, in [0, 1].
     pub increment: f64,
-    /// Number of timesteps a query counts for (at least 1).
+    /// Number of timesteps a query counts for (1 to
+    /// [`limits::WINDOW`]).
     pub window: u64,
 }
 
 #[typetag::serde(name = "demo_counting")]
 impl WorkloadModelConfig for DemoCounting {
     fn build(&self, _ctx: &BuildContext) -> Result<Arc<dyn WorkloadModel>> {
+        self.validate()?;
+        Ok(Arc::new(*self))
+    }
+
+    fn validate(&self) -> Result<()> {
         if !(0.0..=1.0).contains(&self.increment) {
             return Err(HilError::invalid_parameter(
                 "increment",
@@ -49,14 +55,7 @@ impl WorkloadModelConfig for DemoCounting {
                 "must be in [0, 1]",
             ));
         }
-        if self.window == 0 {
-            return Err(HilError::invalid_parameter(
-                "window",
-                0,
-                "must be at least 1",
-            ));
-        }
-        Ok(Arc::new(*self))
+        limits::check_count("window", self.window, limits::WINDOW)
     }
 }
 

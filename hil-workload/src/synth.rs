@@ -26,6 +26,7 @@
 //! any one generated study (the bundled one included) is one draw around
 //! them. See the crate README for the figures.
 
+use hil_core::config::limits;
 use hil_core::{Difficulty, Distraction, ResponseType, Result};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
@@ -157,8 +158,29 @@ impl SynthConfig {
         }
     }
 
+    /// Checks the counts against [`limits::PARTICIPANTS`] and
+    /// [`limits::SURVEYS`] and the survey time against [`limits::SECONDS`];
+    /// [`SynthConfig::generate`] calls it first.
+    pub fn validate(&self) -> Result<()> {
+        for (name, n) in [
+            ("n_no_limitation", self.n_no_limitation),
+            ("n_mobility_limitation", self.n_mobility_limitation),
+            ("n_occupational_therapist", self.n_occupational_therapist),
+            ("n_unlogged", self.n_unlogged),
+        ] {
+            limits::check_at_most(name, n, limits::PARTICIPANTS)?;
+        }
+        limits::check_at_most(
+            "d2_missing_surveys",
+            self.d2_missing_surveys,
+            limits::SURVEYS,
+        )?;
+        limits::check_seconds("survey_time_median_s", self.survey_time_median_s)
+    }
+
     /// Generates the study deterministically from `seed`.
     pub fn generate(&self, seed: u64) -> Result<Study> {
+        self.validate()?;
         let p = &self.params;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let std_normal = Normal::new(0.0, 1.0).expect("valid");

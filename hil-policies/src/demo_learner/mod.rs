@@ -42,6 +42,17 @@ pub struct DemoLearnerConfig {
 #[typetag::serde(name = "demo_learner")]
 impl PolicyConfig for DemoLearnerConfig {
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
+        self.validate()?;
+        let (Some(actions), Some(dim)) = (&ctx.action_space, ctx.context_dim) else {
+            return Err(HilError::state(
+                "demo_learner",
+                "the environment must be built before the policy",
+            ));
+        };
+        Ok(Box::new(DemoLearner::new(actions.len(), dim, self.clone())))
+    }
+
+    fn validate(&self) -> Result<()> {
         for (name, v) in [
             ("query_probability", self.query_probability),
             ("epsilon", self.epsilon),
@@ -54,13 +65,7 @@ impl PolicyConfig for DemoLearnerConfig {
                 ));
             }
         }
-        let (Some(actions), Some(dim)) = (&ctx.action_space, ctx.context_dim) else {
-            return Err(HilError::state(
-                "demo_learner",
-                "the environment must be built before the policy",
-            ));
-        };
-        Ok(Box::new(DemoLearner::new(actions.len(), dim, self.clone())))
+        Ok(())
     }
 }
 

@@ -474,7 +474,7 @@ impl LinearArms {
     }
 }
 
-fn check_lambda(lambda: f64) -> Result<()> {
+pub(crate) fn check_lambda(lambda: f64) -> Result<()> {
     if lambda.is_finite() && lambda > 0.0 {
         Ok(())
     } else {

@@ -106,7 +106,8 @@ impl PolicySpec {
 }
 
 /// Parses the table as an experiment config's `[policy]` (plugin types
-/// included); errors name the offending key.
+/// included) and checks its parameters ([`PolicyConfig::validate`]), as an
+/// experiment file's are; errors name the offending key.
 pub(super) fn parse(table: &toml::Table) -> Result<Box<dyn PolicyConfig>> {
     #[derive(serde::Deserialize)]
     struct Wrapper {
@@ -119,7 +120,14 @@ pub(super) fn parse(table: &toml::Table) -> Result<Box<dyn PolicyConfig>> {
         .map_err(|e| HilError::invalid_input("policy settings", e.to_string()))?;
     // Going through TOML text lets hil-core's loader name the field at fault.
     match parse_toml::<Wrapper>(&text, Path::new("policy settings")) {
-        Ok(w) => Ok(w.policy),
+        Ok(w) => match w.policy.validate() {
+            Ok(()) => Ok(w.policy),
+            Err(HilError::InvalidParameter { name, value, why }) => Err(HilError::invalid_input(
+                format!("policy setting `{name}`"),
+                format!("{value}: {why}"),
+            )),
+            Err(other) => Err(other),
+        },
         Err(e) => {
             let field = e.field.as_deref().unwrap_or("policy");
             let field = field.strip_prefix("policy.").unwrap_or(field);
@@ -223,6 +231,16 @@ mod tests {
             "{e}"
         );
         assert!(e.to_string().contains("linucb_qg"), "{e}");
+        // A value the policy refuses, caught before anything is built.
+        for bad in ["alpha=inf", "w=-1", "lambda=0", "estimator.crossover=nan"] {
+            let t = spec(Some("linucb_qg"), &[bad]).table().unwrap();
+            let key = bad.split('=').next().unwrap();
+            let e = parse(&t).unwrap_err();
+            assert!(
+                matches!(&e, HilError::InvalidInput { what, .. } if what.contains(&format!("`{key}`"))),
+                "{bad}: {e}"
+            );
+        }
         let e = spec(None, &["novalue"]).table().unwrap_err();
         assert!(matches!(e, HilError::InvalidInput { .. }));
     }

@@ -76,6 +76,9 @@ pub struct FigureSettings {
     pub workload: Vec<String>,
 }
 
+/// Most environment or policy seeds a protocol may ask for.
+pub const MAX_SEEDS: u64 = 10_000;
+
 /// Everything that defines a protocol run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -209,6 +212,8 @@ impl ProtocolSettings {
         let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
         hil_core::config::load_plugins(&text, path)?;
         let mut s: Self = hil_core::config::parse_toml(&text, path)?;
+        s.check_counts()
+            .map_err(|e| hil_core::ConfigError::from_error(&text, path, &[], e))?;
         // Paths in the file are relative to the file.
         let base = path.parent().unwrap_or(Path::new(""));
         if let Some(d) = &mut s.dataset {
@@ -220,6 +225,21 @@ impl ProtocolSettings {
             }
         }
         Ok(s)
+    }
+
+    /// Checks every count against its stated limit
+    /// ([`hil_core::config::limits`]; seeds: at most [`MAX_SEEDS`]).
+    pub fn check_counts(&self) -> Result<()> {
+        use hil_core::config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
+        check_count(
+            "items_per_episode",
+            self.items_per_episode,
+            ITEMS_PER_EPISODE,
+        )?;
+        check_count("n_seeds", self.n_seeds, MAX_SEEDS)?;
+        check_at_most("many_seeds", self.many_seeds, MAX_SEEDS)?;
+        check_count("n_policy_seeds", self.n_policy_seeds, MAX_SEEDS)?;
+        Ok(())
     }
 
     /// The dataset the settings name (the bundled one if none).
@@ -258,16 +278,7 @@ impl ProtocolSettings {
     pub fn validate(&self, ds: &FoodDataset, models: &[NamedModel]) -> Result<()> {
         self.split.validate(ds)?;
         self.session.validate()?;
-        let positive = |name: &str, v: usize| {
-            if v == 0 {
-                Err(HilError::invalid_parameter(name, 0, "must be at least 1"))
-            } else {
-                Ok(())
-            }
-        };
-        positive("items_per_episode", self.items_per_episode)?;
-        positive("n_seeds", self.n_seeds)?;
-        positive("n_policy_seeds", self.n_policy_seeds)?;
+        self.check_counts()?;
         if self.w_tasks.is_empty() || self.w_tasks.iter().any(|w| !(0.0..=1.0).contains(w)) {
             return Err(HilError::invalid_parameter(
                 "w_tasks",

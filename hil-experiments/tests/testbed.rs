@@ -371,3 +371,34 @@ type = "simulated_expert"
     assert_eq!(m.m_wt(0.7), rec.metrics.m_wt(0.7));
     assert_eq!(m, &rec.metrics);
 }
+
+#[test]
+fn settings_counts_are_bounded_and_located() {
+    hil_policies::link();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/configs/paper-protocol.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let dir = std::env::temp_dir().join(format!("hil-testbed-limits-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (from, to, field) in [
+        ("many_seeds = 30", "many_seeds = 4294967296", "many_seeds"),
+        ("n_seeds = 3 ", "n_seeds = 0 ", "n_seeds"),
+        (
+            "items_per_episode = 5",
+            "items_per_episode = 9223372036854775807",
+            "items_per_episode",
+        ),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let p = dir.join("s.toml");
+        std::fs::write(&p, text.replace(from, to)).unwrap();
+        match ProtocolSettings::load(&p).unwrap_err() {
+            hil_core::HilError::Config(e) => {
+                assert_eq!(e.field.as_deref(), Some(field));
+                assert!(e.line > 1, "{e}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,4 +1,5 @@
-//! `hil bench policy ...`: time a policy's decide + observe at scale.
+//! `hil bench policy ...`: time a policy's decide + observe at scale;
+//! `hil bench reproduce`: time the README's main job.
 //!
 //! Contexts and rewards are synthetic (random unit-scale vectors, rewards
 //! drawn from a hidden linear model); the point is the cost of the
@@ -11,6 +12,7 @@
 //! traffic (bytes per step, the bandwidth floor) is known only for the
 //! built-in estimator and is reported as absent for other policies.
 
+mod reproduce;
 mod spec;
 
 use std::path::PathBuf;
@@ -37,6 +39,8 @@ pub struct BenchArgs {
 enum BenchWhat {
     /// Median decide + observe time of a policy at a given scale.
     Policy(PolicyBench),
+    /// Wall time of the full default `hil reproduce`.
+    Reproduce(reproduce::ReproduceBench),
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -116,6 +120,7 @@ struct PolicyBench {
 pub fn run(args: BenchArgs) -> Result<()> {
     match args.what {
         BenchWhat::Policy(p) => bench_policy(&p),
+        BenchWhat::Reproduce(r) => reproduce::bench_reproduce(&r),
     }
 }
 

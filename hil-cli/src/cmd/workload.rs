@@ -97,7 +97,7 @@ enum WorkloadCommand {
     },
     /// Print (and optionally plot) WL_t of a model over a query schedule.
     Rollout {
-        /// Model JSON, or `bundled:NAME` (f1_sim, f2_sim, f12_sim, f1_real, f12_real).
+        /// Model JSON, or `bundled:NAME` (`hil_workload::bundled::NAMES`: f1_sim, f2_sim, f12_sim, their `_steep` variants, f1_real, f12_real).
         #[arg(long)]
         model: String,
         /// Queries as `t:response/difficulty/distraction,...`, e.g.

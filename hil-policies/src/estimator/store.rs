@@ -22,13 +22,15 @@ use std::sync::{Arc, Mutex};
 /// forever, and memory must stay bounded).
 pub(crate) const MEMO_LIMIT: usize = 4096;
 
+/// hash of x → (x, products of x with every frozen row).
+type ProductMemo = HashMap<u64, Vec<(Arc<[f64]>, Arc<[f64]>)>>;
+
 /// Rows shared by clones, with the memo of their products.
 #[derive(Debug, Default)]
 struct Frozen {
     data: Vec<f64>,
     index: HashMap<u64, Vec<u32>>,
-    /// hash of x → (x, products with every frozen row).
-    memo: Mutex<HashMap<u64, Vec<(Arc<[f64]>, Arc<[f64]>)>>>,
+    memo: Mutex<ProductMemo>,
 }
 
 /// Rows of length `dim`, each stored once (bitwise equality): the frozen
@@ -148,7 +150,7 @@ impl RowStore {
         out.extend(self.data.chunks_exact(self.dim).map(dot));
     }
 
-    fn memo_lock(&self) -> std::sync::MutexGuard<'_, HashMap<u64, Vec<(Arc<[f64]>, Arc<[f64]>)>>> {
+    fn memo_lock(&self) -> std::sync::MutexGuard<'_, ProductMemo> {
         // A panic while the lock was held can only have left a memo entry
         // out, never a wrong one (entries are pushed whole).
         self.frozen

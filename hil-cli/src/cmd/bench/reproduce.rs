@@ -1,0 +1,67 @@
+//! `hil bench reproduce`: wall time of the README's main job, the full
+//! default `hil reproduce` (the paper's 3-seed protocol and the many-seed
+//! run beside it, selection, aggregation and the frontier), in process.
+
+use std::time::Instant;
+
+use hil_core::{HilError, Result};
+use hil_experiments::results::Reproduction;
+use hil_experiments::{Protocol, ProtocolSettings};
+use serde_json::json;
+
+/// Arguments of `hil bench reproduce`.
+#[derive(Debug, clap::Args)]
+pub struct ReproduceBench {
+    /// Timed runs (the first is also timed: nothing is cached across runs).
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+pub fn bench_reproduce(a: &ReproduceBench) -> Result<()> {
+    hil_core::config::limits::check_count("--runs", a.runs, 100)?;
+    let threads = a
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .max(1);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| HilError::state("thread pool", e.to_string()))?;
+    let mut wall = Vec::with_capacity(a.runs);
+    let mut episodes = 0;
+    for _ in 0..a.runs {
+        let t0 = Instant::now();
+        let settings = ProtocolSettings::paper();
+        let dataset = settings.load_dataset()?;
+        let models = settings.load_models()?;
+        let protocol = Protocol::new(settings.clone(), dataset.clone(), models.clone());
+        let records = pool.install(|| protocol.run_all(&|_, _| {}))?;
+        Reproduction::of(&settings, &models, &records, &dataset.provenance)?;
+        wall.push(t0.elapsed().as_secs_f64());
+        episodes = records.len();
+    }
+    let mut sorted = wall.clone();
+    sorted.sort_by(f64::total_cmp);
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_string))
+        .unwrap_or_default();
+    let out = json!({
+        "job": "hil reproduce (default: 3-seed protocol + 30-seed run, 6 workload models)",
+        "episodes": episodes,
+        "threads": threads,
+        "runs": a.runs,
+        "wall_s": wall,
+        "wall_s_min": sorted.first(),
+        "wall_s_median": sorted[sorted.len() / 2],
+        "loadavg_1min_at_end": load,
+    });
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("bench", e))?
+    );
+    Ok(())
+}

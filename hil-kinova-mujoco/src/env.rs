@@ -143,9 +143,28 @@ impl KinovaFeedingConfig {
     }
 }
 
+/// Largest `context_dim` a Kinova config may ask for.
+pub const MAX_CONTEXT_DIM: u64 = 65_536;
+/// Most `pretraining_trials` per (food, action) a Kinova config may ask for.
+pub const MAX_PRETRAINING_TRIALS: u64 = 10_000;
+
 #[typetag::serde(name = "kinova_feeding")]
+
 impl EnvironmentConfig for KinovaFeedingConfig {
+    fn validate(&self) -> Result<()> {
+        use hil_core::config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
+        check_count("plate", self.plate.len(), ITEMS_PER_EPISODE)?;
+        check_count("context_dim", self.context_dim, MAX_CONTEXT_DIM)?;
+        check_at_most("settings", self.settings.len(), ITEMS_PER_EPISODE)?;
+        check_at_most(
+            "pretraining_trials",
+            self.pretraining_trials,
+            MAX_PRETRAINING_TRIALS,
+        )
+    }
+
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Environment>> {
+        self.validate()?;
         Ok(Box::new(KinovaFeedingEnv::new(self.resolved(ctx))?))
     }
 

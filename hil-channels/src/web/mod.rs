@@ -82,6 +82,11 @@ impl Default for WebChannelConfig {
 
 #[typetag::serde(name = "web")]
 impl QueryChannelConfig for WebChannelConfig {
+    fn validate(&self) -> Result<()> {
+        // The rest (hosts, bind) needs the network stack: `start` checks it.
+        hil_core::config::limits::check_seconds("timeout_s", self.timeout_s)
+    }
+
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
         let mut config = self.clone();
         config.images = config.images.map(|d| ctx.resolve(&d));
@@ -172,13 +177,7 @@ impl std::fmt::Debug for WebChannel {
 impl WebChannel {
     /// Validates `config`, binds the server and starts serving.
     pub fn start(config: WebChannelConfig) -> Result<Self> {
-        if !(config.timeout_s.is_finite() && config.timeout_s > 0.0) {
-            return Err(HilError::invalid_parameter(
-                "timeout_s",
-                config.timeout_s,
-                "must be a positive number of seconds",
-            ));
-        }
+        config.validate()?;
         for h in &config.allowed_hosts {
             if h.is_empty()
                 || !h

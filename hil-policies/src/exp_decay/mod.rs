@@ -135,7 +135,7 @@ mod tests {
     /// Through the policy: the probability at item n's first timestep is
     /// exp(−c·n) with n counted from 1, so over the paper's five test items
     /// the expected f_q gives the paper's 0.160 (c = 0.8) and 0.440 (c = 0.3)
-    /// (counting from 0 would give 0.201 and 0.601).
+    /// (counting from 0 would give 0.357 and 0.599).
     #[test]
     fn the_current_item_counts_as_in_the_paper() {
         for (c, paper_f_q) in [(0.8, 0.160), (0.3, 0.440)] {

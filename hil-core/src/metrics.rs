@@ -191,3 +191,47 @@ pub fn mean_std(xs: &[f64]) -> (f64, f64) {
     let v = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n;
     (m, v.sqrt())
 }
+
+/// The standard error of the mean of `xs`: the sample standard deviation
+/// over √n, that is the population one of [`mean_std`] over √(n − 1).
+/// `None` with fewer than two values, where it is undefined.
+///
+/// ```
+/// assert_eq!(hil_core::metrics::standard_error(&[1.0, 3.0]), Some(1.0));
+/// assert_eq!(hil_core::metrics::standard_error(&[5.0]), None);
+/// ```
+pub fn standard_error(xs: &[f64]) -> Option<f64> {
+    let (_, std) = mean_std(xs);
+    (xs.len() >= 2).then(|| std / (xs.len() as f64 - 1.0).sqrt())
+}
+
+/// Mean, population standard deviation (what the paper's ± reports) and
+/// standard error of the mean of a sample.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Stat {
+    /// Mean.
+    pub mean: f64,
+    /// Population standard deviation.
+    pub std: f64,
+    /// Standard error of the mean ([`standard_error`]; 0 for fewer than
+    /// two values).
+    pub se: f64,
+}
+
+impl Stat {
+    /// The statistics of `xs`.
+    ///
+    /// ```
+    /// let s = hil_core::metrics::Stat::of(&[1.0, 2.0, 3.0]);
+    /// assert_eq!((s.mean, s.std), (2.0, (2.0f64 / 3.0).sqrt()));
+    /// assert!((s.se - 1.0 / 3f64.sqrt()).abs() < 1e-12);
+    /// ```
+    pub fn of(xs: &[f64]) -> Self {
+        let (mean, std) = mean_std(xs);
+        Self {
+            mean,
+            std,
+            se: standard_error(xs).unwrap_or(0.0),
+        }
+    }
+}

@@ -9,7 +9,7 @@ use crate::published::{self, PublishedRow};
 use crate::results::{MetricSummary, ProtocolResults, Spread, Stat};
 
 fn pm(s: Stat, spread: Spread) -> String {
-    format!("{:.3} ± {:.3}", s.mean, s.spread(spread))
+    format!("{:.3} ± {:.3}", s.mean, spread.of(s))
 }
 
 fn ppm(m: f64, s: f64) -> String {

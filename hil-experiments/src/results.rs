@@ -1,7 +1,6 @@
 //! Hyperparameter selection on validation, evaluation on test, and the
 //! aggregated results of a protocol run.
 
-use hil_core::metrics::mean_std;
 use hil_core::{HilError, Result};
 use serde::{Deserialize, Serialize};
 
@@ -10,47 +9,7 @@ use hil_core::EpisodeMetrics;
 use crate::method::GridPoint;
 use crate::testbed::{NamedModel, Phase, ProtocolSettings, RunRecord};
 
-/// Mean, population standard deviation (what the paper's ± reports) and
-/// standard error of the mean over runs.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Stat {
-    /// Mean.
-    pub mean: f64,
-    /// Population standard deviation.
-    pub std: f64,
-    /// Standard error of the mean: sample standard deviation / √n (0 for
-    /// fewer than two runs).
-    pub se: f64,
-}
-
-impl Stat {
-    /// The statistics of `xs`.
-    ///
-    /// ```
-    /// let s = hil_experiments::results::Stat::of(&[1.0, 2.0, 3.0]);
-    /// assert_eq!((s.mean, s.std), (2.0, (2.0f64 / 3.0).sqrt()));
-    /// assert!((s.se - 1.0 / 3f64.sqrt()).abs() < 1e-12);
-    /// ```
-    pub fn of(xs: &[f64]) -> Self {
-        let (mean, std) = mean_std(xs);
-        let n = xs.len() as f64;
-        let se = if xs.len() > 1 {
-            // population variance × n/(n−1) is the sample variance.
-            (std * std * n / (n - 1.0)).sqrt() / n.sqrt()
-        } else {
-            0.0
-        };
-        Self { mean, std, se }
-    }
-
-    /// The spread `spread` asks for.
-    pub fn spread(&self, spread: Spread) -> f64 {
-        match spread {
-            Spread::Std => self.std,
-            Spread::Se => self.se,
-        }
-    }
-}
+pub use hil_core::metrics::Stat;
 
 /// Which spread a table reports after ±.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -60,6 +19,16 @@ pub enum Spread {
     Std,
     /// Standard error of the mean.
     Se,
+}
+
+impl Spread {
+    /// The spread of `stat` this one names.
+    pub fn of(self, stat: Stat) -> f64 {
+        match self {
+            Self::Std => stat.std,
+            Self::Se => stat.se,
+        }
+    }
 }
 
 /// A tuned hyperparameter and its value.

@@ -16,7 +16,7 @@
 use std::ops::Range;
 
 use hil_core::Result;
-use hil_core::metrics::mean_std;
+use hil_core::metrics::{Stat, mean_std};
 use serde::{Deserialize, Serialize};
 
 use crate::datasets::{Dataset, DatasetId};
@@ -65,43 +65,20 @@ impl Draw {
     }
 }
 
-/// Mean, standard deviation over seeds and standard error of the mean.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct OverSeeds {
-    /// Mean over seeds.
-    pub mean: f64,
-    /// Standard deviation over seeds (how far one draw may fall).
-    pub sd: f64,
-    /// Standard error of the mean over seeds.
-    pub se: f64,
-}
-
-impl OverSeeds {
-    fn of(xs: &[f64]) -> Self {
-        let (mean, sd) = mean_std(xs);
-        let n = xs.len() as f64;
-        let se = if xs.len() > 1 {
-            sd * (n / (n - 1.0)).sqrt() / n.sqrt()
-        } else {
-            0.0
-        };
-        Self { mean, sd, se }
-    }
-}
-
 /// The generator's figures over a range of seeds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SeedSpread {
     /// Every draw.
     pub draws: Vec<Draw>,
-    /// D1 mean WL over seeds.
-    pub d1_mean: OverSeeds,
+    /// D1 mean WL over seeds (`std`: how far one draw falls; `se`: how
+    /// well the seeds pin the generator's expectation).
+    pub d1_mean: Stat,
     /// D1 sd WL over seeds.
-    pub d1_sd: OverSeeds,
+    pub d1_sd: Stat,
     /// D2 mean WL over seeds.
-    pub d2_mean: OverSeeds,
+    pub d2_mean: Stat,
     /// D2 sd WL over seeds.
-    pub d2_sd: OverSeeds,
+    pub d2_sd: Stat,
     /// Median p over seeds.
     pub p_median: f64,
     /// Share of seeds with p < 0.05.
@@ -116,17 +93,9 @@ impl SeedSpread {
             .into_par_iter()
             .map(|s| Draw::of(config, s))
             .collect::<Result<_>>()?;
-        let col =
-            |f: &dyn Fn(&Draw) -> f64| OverSeeds::of(&draws.iter().map(f).collect::<Vec<_>>());
-        let mut ps: Vec<f64> = draws.iter().map(|d| d.p).collect();
-        ps.sort_by(f64::total_cmp);
-        let p_median = if ps.is_empty() {
-            f64::NAN
-        } else if ps.len() % 2 == 1 {
-            ps[ps.len() / 2]
-        } else {
-            (ps[ps.len() / 2 - 1] + ps[ps.len() / 2]) / 2.0
-        };
+        let col = |f: &dyn Fn(&Draw) -> f64| Stat::of(&draws.iter().map(f).collect::<Vec<_>>());
+        let ps: Vec<f64> = draws.iter().map(|d| d.p).collect();
+        let p_median = crate::select::median(&ps);
         let p_below_005 = ps.iter().filter(|p| **p < 0.05).count() as f64 / ps.len().max(1) as f64;
         Ok(Self {
             d1_mean: col(&|d| d.d1.1),
@@ -141,10 +110,10 @@ impl SeedSpread {
 
     /// A table beside the paper's figures.
     pub fn to_text(&self) -> String {
-        let row = |name: &str, o: &OverSeeds, paper: f64| {
+        let row = |name: &str, o: &Stat, paper: f64| {
             format!(
                 "{name:<8} {:.3} (SE {:.3}; one draw ± {:.3})   paper {paper}\n",
-                o.mean, o.se, o.sd
+                o.mean, o.se, o.std
             )
         };
         let mut s = format!(

@@ -150,13 +150,13 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
                         "  {m:<13} {:<16} r_task_avg {:.3} ± {:.3}  ΔWL {:+.3} ± {:.3}  M_wt {:.3} ± {:.3}  f_q {:.3} ± {:.3}{}",
                         method.label,
                         r.test.r_task_avg.mean,
-                        r.test.r_task_avg.spread(results.spread),
+                        results.spread.of(r.test.r_task_avg),
                         r.test.delta_wl.mean,
-                        r.test.delta_wl.spread(results.spread),
+                        results.spread.of(r.test.delta_wl),
                         r.test.m_wt.mean,
-                        r.test.m_wt.spread(results.spread),
+                        results.spread.of(r.test.m_wt),
                         r.test.f_q.mean,
-                        r.test.f_q.spread(results.spread),
+                        results.spread.of(r.test.f_q),
                         r.selected
                             .as_ref()
                             .map_or(String::new(), |h| format!("  ({} = {})", h.name, h.value))

@@ -82,8 +82,7 @@ pub struct MeanSem {
     pub sem: Option<f64>,
 }
 
-/// Mean and standard error of `xs` (the population standard deviation of
-/// [`hil_core::metrics::mean_std`], rescaled to the sample one, over √n).
+/// Mean and standard error of `xs` ([`hil_core::metrics::standard_error`]).
 ///
 /// ```
 /// use hil_experiments::user_study::mean_sem;
@@ -92,11 +91,9 @@ pub struct MeanSem {
 /// assert_eq!(mean_sem(&[5.0]).sem, None);
 /// ```
 pub fn mean_sem(xs: &[f64]) -> MeanSem {
-    let (mean, std) = mean_std(xs);
-    let n = xs.len() as f64;
     MeanSem {
-        mean,
-        sem: (xs.len() >= 2).then(|| std / (n - 1.0).sqrt()),
+        mean: mean_std(xs).0,
+        sem: hil_core::metrics::standard_error(xs),
     }
 }
 

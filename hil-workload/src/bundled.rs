@@ -33,17 +33,20 @@ pub const CALIBRATED: [&str; 6] = [
     "f12_sim_steep",
 ];
 
-/// Names of the bundled models.
-pub const NAMES: [&str; 8] = [
-    "f1_sim",
-    "f2_sim",
-    "f12_sim",
-    "f1_sim_steep",
-    "f2_sim_steep",
-    "f12_sim_steep",
-    "f1_real",
-    "f12_real",
-];
+/// Names of the bundled models: [`CALIBRATED`], then [`STUDY_FITTED`].
+pub const NAMES: [&str; CALIBRATED.len() + STUDY_FITTED.len()] = {
+    let mut out = [""; CALIBRATED.len() + STUDY_FITTED.len()];
+    let mut i = 0;
+    while i < out.len() {
+        out[i] = if i < CALIBRATED.len() {
+            CALIBRATED[i]
+        } else {
+            STUDY_FITTED[i - CALIBRATED.len()]
+        };
+        i += 1;
+    }
+    out
+};
 
 /// The JSON text of a bundled model.
 pub fn json(name: &str) -> Option<&'static str> {

@@ -69,6 +69,9 @@ pub const GAMMA: f64 = 0.05;
 /// type, distraction).
 const ACTIVE_FEATURES: f64 = 3.0;
 
+/// What [`End::model_name`] appends for the steep end.
+const STEEP_SUFFIX: &str = "_steep";
+
 /// Which end of the open direction a calibrated model takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum End {
@@ -86,7 +89,22 @@ impl End {
     pub fn model_name(self, model: &str) -> String {
         match self {
             Self::Lean => model.to_string(),
-            Self::Steep => format!("{model}_steep"),
+            Self::Steep => format!("{model}{STEEP_SUFFIX}"),
+        }
+    }
+
+    /// The inverse of [`End::model_name`]: the base model and the end a
+    /// name stands for (any name without the steep suffix is `Lean`).
+    ///
+    /// ```
+    /// use hil_experiments::calibrate::End;
+    /// assert_eq!(End::split("f2_sim_steep"), ("f2_sim", End::Steep));
+    /// assert_eq!(End::split("f2_sim"), ("f2_sim", End::Lean));
+    /// ```
+    pub fn split(name: &str) -> (&str, Self) {
+        match name.strip_suffix(STEEP_SUFFIX) {
+            Some(base) => (base, Self::Steep),
+            None => (name, Self::Lean),
         }
     }
 }
@@ -432,7 +450,7 @@ mod tests {
     #[test]
     fn every_model_meets_every_target_within_tolerance() {
         for m in all().unwrap() {
-            let base = m.name.trim_end_matches("_steep");
+            let (base, _) = End::split(&m.name);
             let t = targets(base).unwrap();
             for r in check(&m, &t).unwrap() {
                 assert!(r.error().abs() <= TOLERANCE, "{} {}: {r:?}", m.name, r.what);
@@ -473,7 +491,7 @@ mod tests {
     fn where_the_extra_attempts_fall_does_not_matter() {
         for m in all().unwrap() {
             let model: &dyn WorkloadModel = &m;
-            let base = m.name.trim_end_matches("_steep");
+            let (base, _) = End::split(&m.name);
             let t = targets(base).unwrap();
             for t_final in [8u64, 9] {
                 let mut seen = Vec::new();

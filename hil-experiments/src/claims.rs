@@ -14,6 +14,7 @@ use std::fmt::Write as _;
 
 use hil_core::Result;
 
+use crate::calibrate::End;
 use crate::published;
 use crate::results::{ProtocolResults, Stat};
 
@@ -150,8 +151,8 @@ pub fn claims_markdown(res: &ProtocolResults) -> Result<String> {
         o,
         "The paper: f_q rises from D2 to D1,2 to D1 (0.333, 0.667, 0.867).\n\n| comparison | difference | verdict |\n|---|---|---|"
     );
-    for suffix in ["", "_steep"] {
-        let name = |base: &str| format!("{base}{suffix}");
+    for end in End::ALL {
+        let name = |base: &str| end.model_name(base);
         for (lo, hi) in [("f2_sim", "f12_sim"), ("f12_sim", "f1_sim")] {
             if let (Some(a), Some(b)) = (
                 get(&name(hi), "LinUCB-QG", f_q),

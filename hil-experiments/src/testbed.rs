@@ -45,6 +45,7 @@ use hil_envs::env::{PretrainReward, pretraining_data};
 use hil_envs::{DatasetReplayEnv, FoodDataset, FoodSplit};
 use rayon::prelude::*;
 
+use crate::calibrate::End;
 use crate::method::{GridPoint, Method, paper_policy};
 use serde::{Deserialize, Serialize};
 
@@ -139,8 +140,8 @@ impl ProtocolSettings {
         };
         let cross_steep = |decide: &str| CrossSetting {
             method: "LinUCB-QG".into(),
-            decide: format!("{decide}_steep"),
-            score: "f2_sim_steep".into(),
+            decide: End::Steep.model_name(decide),
+            score: End::Steep.model_name("f2_sim"),
         };
         Self {
             plugins: Vec::new(),
@@ -440,7 +441,10 @@ impl ModelSource {
             name: name.into(),
             bundled: Some(name.into()),
             file: None,
-            paper: name.strip_suffix("_steep").map(str::to_string),
+            paper: match End::split(name) {
+                (base, End::Steep) => Some(base.to_string()),
+                (_, End::Lean) => None,
+            },
         }
     }
 

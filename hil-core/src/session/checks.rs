@@ -15,35 +15,30 @@ use crate::query::{QueryKind, Response};
 use crate::time::Timestep;
 use crate::workload::{QueryHistory, WorkloadModel};
 
-/// Every diagnostic of a policy's decision must be finite.
+/// Every diagnostic of a policy's decision must be finite. Runs at every
+/// step, so it allocates only to name a bad field.
 pub(crate) fn diagnostics(policy: &str, d: &Diagnostics) -> Result<()> {
-    let fields = d
-        .arms
-        .iter()
-        .enumerate()
-        .flat_map(|(i, a)| {
-            [
-                (format!("arms[{i}].estimate"), a.estimate),
-                (format!("arms[{i}].bonus"), a.bonus),
-                (format!("arms[{i}].ucb"), a.ucb),
-            ]
-        })
-        .chain(
-            [
-                ("gap", d.gap),
-                ("threshold", d.threshold),
-                ("query_probability", d.query_probability),
-                ("workload_forecast", d.workload_forecast),
-            ]
-            .into_iter()
-            .filter_map(|(name, v)| v.map(|v| (name.to_string(), v))),
-        );
-    for (field, v) in fields {
-        if !v.is_finite() {
-            return Err(HilError::invalid_input(
-                format!("`diagnostics.{field}` of policy `{policy}`"),
-                format!("{v} is not a finite number"),
-            ));
+    let bad = |field: String, v: f64| {
+        Err(HilError::invalid_input(
+            format!("`diagnostics.{field}` of policy `{policy}`"),
+            format!("{v} is not a finite number"),
+        ))
+    };
+    for (i, a) in d.arms.iter().enumerate() {
+        for (name, v) in [("estimate", a.estimate), ("bonus", a.bonus), ("ucb", a.ucb)] {
+            if !v.is_finite() {
+                return bad(format!("arms[{i}].{name}"), v);
+            }
+        }
+    }
+    for (name, v) in [
+        ("gap", d.gap),
+        ("threshold", d.threshold),
+        ("query_probability", d.query_probability),
+        ("workload_forecast", d.workload_forecast),
+    ] {
+        if let Some(v) = v.filter(|v| !v.is_finite()) {
+            return bad(name.to_string(), v);
         }
     }
     Ok(())

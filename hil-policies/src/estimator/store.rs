@@ -17,7 +17,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
-/// Most contexts whose products with the frozen rows are memoised; beyond
+/// Most context hashes whose products with the frozen rows are memoised; beyond
 /// it, products are computed every time (a live robot sees new contexts
 /// forever, and memory must stay bounded).
 pub(crate) const MEMO_LIMIT: usize = 4096;
@@ -141,7 +141,9 @@ impl RowStore {
                     let g: Arc<[f64]> = self.frozen.data.chunks_exact(self.dim).map(dot).collect();
                     out.extend_from_slice(&g);
                     let mut memo = self.memo_lock();
-                    if memo.values().map(Vec::len).sum::<usize>() < MEMO_LIMIT {
+                    // Counting hashes, not entries: collisions are rare, and
+                    // summing the buckets on every miss would cost O(memo).
+                    if memo.len() < MEMO_LIMIT {
                         memo.entry(h).or_default().push((x.into(), g));
                     }
                 }

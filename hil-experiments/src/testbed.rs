@@ -47,6 +47,7 @@ use rayon::prelude::*;
 
 use crate::calibrate::End;
 use crate::method::{GridPoint, Method, paper_policy};
+use crate::results::Reproduction;
 use serde::{Deserialize, Serialize};
 
 /// A cross-data setting: a method deciding with one model, scored with another.
@@ -596,6 +597,26 @@ impl Protocol {
             models,
             channel: perfect_expert,
         }
+    }
+
+    /// The protocol over the dataset and workload models `settings` name
+    /// (loaded and checked against them).
+    pub fn from_settings(settings: ProtocolSettings) -> Result<Self> {
+        let dataset = settings.load_dataset()?;
+        let models = settings.load_models()?;
+        settings.validate(&dataset, &models)?;
+        Ok(Self::new(settings, dataset, models))
+    }
+
+    /// Selection, aggregation and the frontier of this protocol's `records`
+    /// ([`Reproduction::of`]).
+    pub fn reproduction(&self, records: &[RunRecord]) -> Result<Reproduction> {
+        Reproduction::of(
+            &self.settings,
+            &self.models,
+            records,
+            &self.dataset.provenance,
+        )
     }
 
     /// The build context of every policy: the dataset's actions and

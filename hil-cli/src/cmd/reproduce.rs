@@ -6,13 +6,10 @@
 //! hil-workload's bundled simulation models.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Instant;
 
 use hil_core::HilError;
-use hil_envs::FoodDataset;
 use hil_experiments::output::{Timing, write_outputs};
-use hil_experiments::results::Reproduction;
 use hil_experiments::{Protocol, ProtocolSettings};
 
 /// Arguments of `hil reproduce`.
@@ -68,7 +65,6 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
     if let Some(n) = args.many_seeds {
         settings.many_seeds = n;
     }
-    let dataset: Arc<FoodDataset> = settings.load_dataset()?;
     if let Some(s) = args.seed {
         settings.seed = s;
     }
@@ -81,17 +77,9 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
             }
         }
     }
-    let models = settings.load_models()?;
-    settings.validate(&dataset, &models)?;
-    let protocol = Protocol::new(settings.clone(), dataset.clone(), models.clone());
-    let threads = args
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .max(1);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| HilError::state("thread pool", e.to_string()))?;
+    let protocol = Protocol::from_settings(settings)?;
+    let (settings, dataset, models) = (&protocol.settings, &protocol.dataset, &protocol.models);
+    let (pool, threads) = super::worker_pool(args.threads)?;
     let total = protocol.jobs()?.len();
     let setup_s = t0.elapsed().as_secs_f64();
     let bar = if args.quiet {
@@ -112,7 +100,7 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
     let runs_s = t1.elapsed().as_secs_f64();
 
     let t2 = Instant::now();
-    let reproduction = Reproduction::of(&settings, &models, &records, &dataset.provenance)?;
+    let reproduction = protocol.reproduction(&records)?;
     let mut timing = Timing {
         setup_s,
         runs_s,
@@ -120,9 +108,9 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         threads,
     };
     // Write once to measure, then again with the report time included.
-    write_outputs(&args.out, &reproduction, &records, &models, &timing)?;
+    write_outputs(&args.out, &reproduction, &records, models, &timing)?;
     timing.report_s = t2.elapsed().as_secs_f64();
-    let written = write_outputs(&args.out, &reproduction, &records, &models, &timing)?;
+    let written = write_outputs(&args.out, &reproduction, &records, models, &timing)?;
 
     if !args.quiet {
         eprintln!(

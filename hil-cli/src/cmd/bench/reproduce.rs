@@ -5,7 +5,6 @@
 use std::time::Instant;
 
 use hil_core::{HilError, Result};
-use hil_experiments::results::Reproduction;
 use hil_experiments::{Protocol, ProtocolSettings};
 use serde_json::json;
 
@@ -22,24 +21,14 @@ pub struct ReproduceBench {
 
 pub fn bench_reproduce(a: &ReproduceBench) -> Result<()> {
     hil_core::config::limits::check_count("--runs", a.runs, 100)?;
-    let threads = a
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .max(1);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| HilError::state("thread pool", e.to_string()))?;
+    let (pool, threads) = crate::cmd::worker_pool(a.threads)?;
     let mut wall = Vec::with_capacity(a.runs);
     let mut episodes = 0;
     for _ in 0..a.runs {
         let t0 = Instant::now();
-        let settings = ProtocolSettings::paper();
-        let dataset = settings.load_dataset()?;
-        let models = settings.load_models()?;
-        let protocol = Protocol::new(settings.clone(), dataset.clone(), models.clone());
+        let protocol = Protocol::from_settings(ProtocolSettings::paper())?;
         let records = pool.install(|| protocol.run_all(&|_, _| {}))?;
-        Reproduction::of(&settings, &models, &records, &dataset.provenance)?;
+        protocol.reproduction(&records)?;
         wall.push(t0.elapsed().as_secs_f64());
         episodes = records.len();
     }

@@ -357,9 +357,10 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             Ok(())
         }
         WorkloadCommand::Calibrate { dir, check } => {
-            print!("{}", hil_experiments::calibrate::report()?);
+            let models = hil_experiments::calibrate::all()?;
+            print!("{}", hil_experiments::calibrate::report(&models)?);
             let mut stale = Vec::new();
-            for m in hil_experiments::calibrate::all()? {
+            for m in models {
                 let path = dir.join(format!("models/{}.json", m.name));
                 if check {
                     let on_disk =

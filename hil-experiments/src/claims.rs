@@ -32,8 +32,7 @@ pub enum Verdict {
 impl Verdict {
     /// `a − b` should be positive (`expect_greater`) or negative.
     pub fn of(a: Stat, b: Stat, expect_greater: bool) -> Self {
-        let d = a.mean - b.mean;
-        let se = (a.se * a.se + b.se * b.se).sqrt();
+        let (d, se) = difference(a, b);
         let signed = if expect_greater { d } else { -d };
         if signed > 2.0 * se {
             Self::Holds
@@ -53,12 +52,14 @@ impl Verdict {
     }
 }
 
+/// a − b and its standard error, the two taken as independent.
+fn difference(a: Stat, b: Stat) -> (f64, f64) {
+    (a.mean - b.mean, a.se.hypot(b.se))
+}
+
 fn diff(a: Stat, b: Stat) -> String {
-    format!(
-        "{:+.3} ± {:.3}",
-        a.mean - b.mean,
-        (a.se * a.se + b.se * b.se).sqrt()
-    )
+    let (d, se) = difference(a, b);
+    format!("{d:+.3} ± {se:.3}")
 }
 
 /// The claims section for `res` (meant for the many-seed run).

@@ -77,8 +77,11 @@ pub fn write_outputs(
     .map_err(|e| HilError::serde("results", e))?;
     write(&results_path, &json)?;
     let tables = dir.join("tables.md");
+    // The time is that of every episode run, so only the run that holds
+    // them all (the many-seed one, if any) states it.
     let elapsed = Some(timing.runs_s + timing.setup_s);
-    let mut md = tables_markdown(&reproduction.paper_protocol, elapsed)?;
+    let paper_elapsed = elapsed.filter(|_| reproduction.many_seeds.is_none());
+    let mut md = tables_markdown(&reproduction.paper_protocol, paper_elapsed)?;
     if let Some(many) = &reproduction.many_seeds {
         md.push('\n');
         md.push_str(&tables_markdown(many, elapsed)?);

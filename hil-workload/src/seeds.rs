@@ -16,11 +16,11 @@
 use std::ops::Range;
 
 use hil_core::Result;
-use hil_core::metrics::{Stat, mean_std};
+use hil_core::metrics::Stat;
 use serde::{Deserialize, Serialize};
 
-use crate::datasets::{Dataset, DatasetId};
-use crate::stats::{Alternative, mann_whitney_u};
+use crate::bundle::StudySummary;
+use crate::datasets::DatasetId;
 use crate::synth::SynthConfig;
 
 /// The paper's D1 mean querying workload.
@@ -48,19 +48,28 @@ pub struct Draw {
 }
 
 impl Draw {
-    /// The figures of the study generated from `seed`.
+    /// The figures of the study generated from `seed` (its
+    /// [`StudySummary`], the one `hil workload summary` prints).
     pub fn of(config: &SynthConfig, seed: u64) -> Result<Self> {
         let study = config.generate(seed)?;
-        let t1 = Dataset::build(&study, DatasetId::D1)?.targets();
-        let t2 = Dataset::build(&study, DatasetId::D2)?.targets();
-        let (m1, s1) = mean_std(&t1);
-        let (m2, s2) = mean_std(&t2);
-        let p = mann_whitney_u(&t1, &t2, Alternative::Less)?.p_value;
+        let summary = StudySummary::of(&study)?;
+        let figures = |id: DatasetId| {
+            summary
+                .datasets
+                .iter()
+                .find(|d| d.0 == id)
+                .map(|&(_, n, m, sd, _)| (n, m, sd))
+                .ok_or_else(|| crate::datasets::no_query_rows(&study, id))
+        };
         Ok(Self {
             seed,
-            d1: (t1.len(), m1, s1),
-            d2: (t2.len(), m2, s2),
-            p,
+            d1: figures(DatasetId::D1)?,
+            d2: figures(DatasetId::D2)?,
+            // Present whenever D1 and D2 are.
+            p: summary
+                .d1_less_than_d2
+                .map(|t| t.p_value)
+                .ok_or_else(|| crate::datasets::no_query_rows(&study, DatasetId::D2))?,
         })
     }
 }

@@ -63,4 +63,6 @@ pub use session::{
     StepDecision, StepEvent,
 };
 pub use time::{TimeGrid, Timestep};
-pub use workload::{QueryHistory, QueryRecord, WorkloadForecast, WorkloadModel, WorkloadTracker};
+pub use workload::{
+    QueryHistory, QueryRecord, WorkloadForecast, WorkloadInput, WorkloadModel, WorkloadTracker,
+};

@@ -98,6 +98,51 @@ impl QueryHistory {
     }
 }
 
+/// What a workload model is asked: the initial workload, the queries asked
+/// so far and the timestep to predict at.
+///
+/// A struct rather than positional arguments, so that a later covariate
+/// (time of day, the person's own rating) is a new field with a default, not
+/// a change to every model's signature. Build it with [`WorkloadInput::new`].
+///
+/// ```
+/// use hil_core::{QueryHistory, WorkloadInput};
+/// let h = QueryHistory::new();
+/// let input = WorkloadInput::new(0.5, &h, 3);
+/// assert_eq!((input.wl0, input.t, input.history.len()), (0.5, 3, 0));
+/// ```
+#[derive(Clone, Copy, Debug)]
+#[non_exhaustive]
+pub struct WorkloadInput<'a> {
+    /// The initial workload WL_0, in [0, 1].
+    pub wl0: f64,
+    /// The queries asked so far; queries later than `t` are ignored.
+    pub history: &'a QueryHistory,
+    /// The timestep to predict at.
+    pub t: Timestep,
+}
+
+impl<'a> WorkloadInput<'a> {
+    /// The input for WL_t given WL_0 and the queries in `history`.
+    pub fn new(wl0: f64, history: &'a QueryHistory, t: Timestep) -> Self {
+        Self { wl0, history, t }
+    }
+
+    /// The same question about another history (e.g. a counterfactual one).
+    pub fn with_history<'b>(&self, history: &'b QueryHistory) -> WorkloadInput<'b> {
+        WorkloadInput {
+            wl0: self.wl0,
+            history,
+            t: self.t,
+        }
+    }
+
+    /// The same question at another timestep.
+    pub fn at(&self, t: Timestep) -> Self {
+        Self { t, ..*self }
+    }
+}
+
 /// A model of querying workload: WL_t = f(WL_0, Q_t).
 ///
 /// Contract (checked by `hil_core::testing::check_workload_model`):
@@ -108,21 +153,15 @@ pub trait WorkloadModel: Send + Sync {
     /// Short name for logs.
     fn name(&self) -> &str;
 
-    /// Predicts WL_t from the initial workload and the queries asked up to `t`.
-    /// Queries in `history` later than `t` are ignored.
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64>;
+    /// Predicts WL_t from the initial workload and the queries asked up to
+    /// `input.t`.
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64>;
 
-    /// The counterfactual WL_t if a query of `kind` were asked now, at `t`.
-    fn predict_if_queried(
-        &self,
-        wl0: f64,
-        history: &QueryHistory,
-        t: Timestep,
-        kind: QueryKind,
-    ) -> Result<f64> {
-        let mut h = history.clone();
-        h.push(t, kind)?;
-        self.predict(wl0, &h, t)
+    /// The counterfactual WL_t if a query of `kind` were asked now, at `input.t`.
+    fn predict_if_queried(&self, input: &WorkloadInput<'_>, kind: QueryKind) -> Result<f64> {
+        let mut h = input.history.clone();
+        h.push(input.t, kind)?;
+        self.predict(&input.with_history(&h))
     }
 }
 
@@ -193,12 +232,13 @@ impl<'a> WorkloadForecast<'a> {
     /// The predicted WL_t if a query of `kind` were asked now.
     pub fn if_queried(&self, kind: QueryKind) -> Result<f64> {
         self.model()?
-            .predict_if_queried(self.wl0, self.history, self.t, kind)
+            .predict_if_queried(&WorkloadInput::new(self.wl0, self.history, self.t), kind)
     }
 
     /// The predicted WL_t without a query now.
     pub fn now(&self) -> Result<f64> {
-        self.model()?.predict(self.wl0, self.history, self.t)
+        self.model()?
+            .predict(&WorkloadInput::new(self.wl0, self.history, self.t))
     }
 
     fn model(&self) -> Result<&'a dyn WorkloadModel> {
@@ -234,7 +274,7 @@ pub fn workload_at(
     if t == 0 {
         return Ok(wl0);
     }
-    let wl = model.predict(wl0, history, t)?;
+    let wl = model.predict(&WorkloadInput::new(wl0, history, t))?;
     if !wl.is_finite() {
         return Err(HilError::invalid_input(
             format!("workload prediction of `{}`", model.name()),
@@ -250,12 +290,12 @@ pub fn workload_at(
 ///
 /// ```
 /// use std::sync::Arc;
-/// use hil_core::{WorkloadTracker, QueryKind, WorkloadModel, QueryHistory, Timestep};
+/// use hil_core::{WorkloadTracker, QueryKind, WorkloadModel, WorkloadInput};
 /// # struct PerQuery;
 /// # impl WorkloadModel for PerQuery {
 /// #     fn name(&self) -> &str { "per_query" }
-/// #     fn predict(&self, wl0: f64, h: &QueryHistory, _t: Timestep) -> hil_core::Result<f64> {
-/// #         Ok((wl0 + 0.1 * h.len() as f64).min(1.0))
+/// #     fn predict(&self, x: &WorkloadInput<'_>) -> hil_core::Result<f64> {
+/// #         Ok((x.wl0 + 0.1 * x.history.len() as f64).min(1.0))
 /// #     }
 /// # }
 /// let mut tr = WorkloadTracker::new(Arc::new(PerQuery), 0.5).unwrap();

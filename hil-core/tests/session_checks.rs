@@ -10,8 +10,7 @@ use hil_core::record::{Header, RecordLog, run_recorded};
 use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::{
     ActionSpace, ArmId, Choice, Decision, DecisionInput, Diagnostics, Experiment, Feedback,
-    HilError, Policy, Query, QueryChannel, QueryHistory, QueryKind, Response, SessionSettings,
-    Timestep, WorkloadModel,
+    HilError, Policy, Query, QueryChannel, QueryKind, Response, SessionSettings, WorkloadModel,
 };
 
 /// Decides like `ScriptedPolicy` but reports a NaN gap.
@@ -46,8 +45,12 @@ impl WorkloadModel for OutOfRange {
     fn name(&self) -> &str {
         "out_of_range"
     }
-    fn predict(&self, wl0: f64, history: &QueryHistory, _t: Timestep) -> hil_core::Result<f64> {
-        Ok(if history.is_empty() { wl0 } else { 2.83 })
+    fn predict(&self, input: &hil_core::WorkloadInput<'_>) -> hil_core::Result<f64> {
+        Ok(if input.history.is_empty() {
+            input.wl0
+        } else {
+            2.83
+        })
     }
 }
 

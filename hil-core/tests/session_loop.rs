@@ -374,13 +374,8 @@ impl hil_core::WorkloadModel for Decaying {
     fn name(&self) -> &str {
         "decaying"
     }
-    fn predict(
-        &self,
-        wl0: f64,
-        h: &hil_core::QueryHistory,
-        t: hil_core::Timestep,
-    ) -> hil_core::Result<f64> {
-        Ok(wl0 - 0.1 + 0.3 * h.recent(t, 2).count() as f64)
+    fn predict(&self, input: &hil_core::WorkloadInput<'_>) -> hil_core::Result<f64> {
+        Ok(input.wl0 - 0.1 + 0.3 * input.history.recent(input.t, 2).count() as f64)
     }
 }
 

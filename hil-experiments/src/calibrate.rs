@@ -54,6 +54,7 @@ use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadMode
 use hil_workload::models::{FittedModel, GrangerModel, GrangerVariant, ModelSpec, Provenance};
 
 use crate::testbed::ProtocolSettings;
+use hil_core::WorkloadInput;
 
 /// The simulation models, in the paper's table order.
 pub const SIM_MODELS: [&str; 3] = ["f1_sim", "f2_sim", "f12_sim"];
@@ -382,7 +383,7 @@ pub fn check(model: &FittedModel, targets: &Targets) -> Result<Vec<Readout>> {
         for &q in &s.queries {
             h.push(q, QueryKind::default())?;
         }
-        m.predict(targets.wl0, &h, s.t_final)
+        m.predict(&WorkloadInput::new(targets.wl0, &h, s.t_final))
     };
     let longest = targets
         .schedules
@@ -502,7 +503,11 @@ mod tests {
                                 for q in [1, a, b, c, d] {
                                     h.push(q, QueryKind::default()).unwrap();
                                 }
-                                seen.push(model.predict(t.wl0, &h, t_final).unwrap());
+                                seen.push(
+                                    model
+                                        .predict(&WorkloadInput::new(t.wl0, &h, t_final))
+                                        .unwrap(),
+                                );
                             }
                         }
                     }
@@ -527,8 +532,12 @@ mod tests {
             let mut curves = (Vec::new(), Vec::new());
             for q in 1..=6u64 {
                 h.push(q, QueryKind::default()).unwrap();
-                curves.0.push(lean.predict(t.wl0, &h, q).unwrap());
-                curves.1.push(steep.predict(t.wl0, &h, q).unwrap());
+                curves
+                    .0
+                    .push(lean.predict(&WorkloadInput::new(t.wl0, &h, q)).unwrap());
+                curves
+                    .1
+                    .push(steep.predict(&WorkloadInput::new(t.wl0, &h, q)).unwrap());
             }
             for c in [&curves.0, &curves.1] {
                 assert!(c.windows(2).all(|w| w[1] >= w[0]), "{model}: {c:?}");

@@ -1,9 +1,10 @@
 //! The "gap monotonicity" property suite for LinUCB-QG and its estimator.
 
+use hil_core::WorkloadInput;
 use hil_core::testing::strategies::context;
 use hil_core::{
     ArmId, Choice, Context, DecisionInput, LabelledObservation, Policy, QueryHistory, QueryKind,
-    Result, Timestep, WorkloadForecast, WorkloadModel,
+    Result, WorkloadForecast, WorkloadModel,
 };
 use hil_policies::estimator::reference::NaiveArms;
 use hil_policies::{
@@ -55,7 +56,7 @@ impl WorkloadModel for Fixed {
     fn name(&self) -> &str {
         "fixed"
     }
-    fn predict(&self, _: f64, _: &QueryHistory, _: Timestep) -> Result<f64> {
+    fn predict(&self, _: &WorkloadInput<'_>) -> Result<f64> {
         Ok(self.0)
     }
 }

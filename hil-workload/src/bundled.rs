@@ -84,9 +84,9 @@ pub fn load_fitted(name: &str) -> Result<FittedModel> {
 /// use hil_core::{QueryHistory, QueryKind, WorkloadModel};
 /// let m = hil_workload::bundled::load("f1_sim").unwrap();
 /// let mut h = QueryHistory::new();
-/// let before = m.predict(0.5, &h, 3).unwrap();
+/// let before = m.predict(&WorkloadInput::new(0.5, &h, 3)).unwrap();
 /// h.push(3, QueryKind::default()).unwrap();
-/// assert!(m.predict(0.5, &h, 3).unwrap() >= before);
+/// assert!(m.predict(&WorkloadInput::new(0.5, &h, 3)).unwrap() >= before);
 /// assert!(hil_workload::bundled::load("nope").is_err());
 /// ```
 pub fn load(name: &str) -> Result<Arc<dyn WorkloadModel>> {

@@ -8,8 +8,9 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use hil_core::WorkloadInput;
 use hil_core::config::{WorkloadModelConfig, limits};
-use hil_core::{BuildContext, HilError, QueryHistory, Result, Timestep, WorkloadModel};
+use hil_core::{BuildContext, HilError, QueryHistory, Result, WorkloadModel};
 
 /// Config of the demo workload model, `type = "demo_counting"`:
 ///
@@ -27,7 +28,7 @@ use hil_core::{BuildContext, HilError, QueryHistory, Result, Timestep, WorkloadM
 /// let model = DemoCounting { increment: 0.1, window: 10 };
 /// let mut history = QueryHistory::new();
 /// history.push(4, QueryKind::default())?;
-/// assert!((model.predict(0.5, &history, 5)? - 0.6).abs() < 1e-12);
+/// assert!((model.predict(&WorkloadInput::new(0.5, &history, 5))? - 0.6).abs() < 1e-12);
 /// # Ok::<(), hil_core::HilError>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -64,9 +65,9 @@ impl WorkloadModel for DemoCounting {
     fn name(&self) -> &str {
         "demo_counting"
     }
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        let n = history.recent(t, self.window).count();
-        Ok((wl0 + self.increment * n as f64).clamp(0.0, 1.0))
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        let n = input.history.recent(input.t, self.window).count();
+        Ok((input.wl0 + self.increment * n as f64).clamp(0.0, 1.0))
     }
 }
 
@@ -93,8 +94,8 @@ mod tests {
         let mut h = QueryHistory::new();
         h.push(1, QueryKind::default()).unwrap();
         h.push(2, QueryKind::default()).unwrap();
-        assert!((m.predict(0.2, &h, 2).unwrap() - 0.4).abs() < 1e-12);
-        assert!((m.predict(0.2, &h, 10).unwrap() - 0.2).abs() < 1e-12);
+        assert!((m.predict(&WorkloadInput::new(0.2, &h, 2)).unwrap() - 0.4).abs() < 1e-12);
+        assert!((m.predict(&WorkloadInput::new(0.2, &h, 10)).unwrap() - 0.2).abs() < 1e-12);
     }
 
     #[test]

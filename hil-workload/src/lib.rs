@@ -24,7 +24,7 @@
 //! let model = hil_workload::bundled::load("f12_real").unwrap();
 //! let mut history = QueryHistory::new();
 //! history.push(1, QueryKind::default()).unwrap();
-//! let wl = model.predict(0.5, &history, 1).unwrap();
+//! let wl = model.predict(&WorkloadInput::new(0.5, &history, 1)).unwrap();
 //! assert!((0.0..=1.0).contains(&wl));
 //! ```
 

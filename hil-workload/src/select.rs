@@ -25,6 +25,7 @@ use crate::fit::{BoxLsq, Gram};
 use crate::models::{
     AverageModel, ConstantModel, ExpImpulseModel, GrangerModel, GrangerVariant, ModelSpec,
 };
+use hil_core::WorkloadInput;
 
 /// Options of a selection run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -284,10 +285,11 @@ impl<'a> Problem<'a> {
         let (mut s, mut n) = (0.0, 0usize);
         for i in self.rows_of(parts) {
             let p = self.pairs[i];
-            let e = spec
-                .as_model()
-                .predict(p.wl0, &p.history.to_history(), p.t)?
-                - p.target;
+            let e = spec.as_model().predict(&WorkloadInput::new(
+                p.wl0,
+                &p.history.to_history(),
+                p.t,
+            ))? - p.target;
             s += e * e;
             n += 1;
         }

@@ -1,5 +1,6 @@
 //! The `bundled` and `model_file` workload-model configs.
 
+use hil_core::WorkloadInput;
 use hil_core::config::WorkloadModelConfig;
 use hil_core::{BuildContext, QueryHistory};
 
@@ -15,7 +16,11 @@ fn bundled_config_builds_every_bundled_model() {
         let cfg = parse(&format!(r#"{{"type": "bundled", "name": "{name}"}}"#)).unwrap();
         let m = cfg.build(&ctx).unwrap();
         assert_eq!(m.name(), name);
-        assert!(m.predict(0.5, &QueryHistory::new(), 0).unwrap().is_finite());
+        assert!(
+            m.predict(&WorkloadInput::new(0.5, &QueryHistory::new(), 0))
+                .unwrap()
+                .is_finite()
+        );
     }
     let e = parse(r#"{"type": "bundled", "name": "f9"}"#)
         .unwrap()

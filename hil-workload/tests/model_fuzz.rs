@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use hil_core::WorkloadInput;
 use hil_core::testing::mutate::mutated;
 use hil_core::{HilError, QueryHistory, QueryKind, WorkloadModel};
 use hil_workload::models::{
@@ -50,7 +51,7 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
             for h in histories() {
                 for t in [0, 5, 2000] {
                     // Any result, but no panic.
-                    let _ = m.predict(0.5, &h, t);
+                    let _ = m.predict(&WorkloadInput::new(0.5, &h, t));
                 }
             }
             Ok(())

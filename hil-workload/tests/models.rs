@@ -2,6 +2,7 @@
 //! monotonicity of the constrained variants, consistency of the fast
 //! cross-validation path with the models' own predictions.
 
+use hil_core::WorkloadInput;
 use hil_core::testing::check_workload_model;
 use hil_core::testing::strategies::{query_history, query_kind};
 use hil_core::{QueryHistory, WorkloadModel};
@@ -65,8 +66,8 @@ fn json_round_trip_gives_bit_identical_predictions() {
         assert_eq!(&back, m);
         for p in &d.pairs {
             let h = p.history.to_history();
-            let a = m.predict(p.wl0, &h, p.t).unwrap();
-            let b = back.predict(p.wl0, &h, p.t).unwrap();
+            let a = m.predict(&WorkloadInput::new(p.wl0, &h, p.t)).unwrap();
+            let b = back.predict(&WorkloadInput::new(p.wl0, &h, p.t)).unwrap();
             assert_eq!(a.to_bits(), b.to_bits(), "{}", m.name);
         }
     }
@@ -113,7 +114,9 @@ fn sparse_design_path_matches_model_predictions() {
                 let fast = SparseRow::of_pair(p, g.history)
                     .dot_prefix(&w)
                     .clamp(0.0, 1.0);
-                let slow = g.predict(p.wl0, &p.history.to_history(), p.t).unwrap();
+                let slow = g
+                    .predict(&WorkloadInput::new(p.wl0, &p.history.to_history(), p.t))
+                    .unwrap();
                 assert!((fast - slow).abs() < 1e-12, "{}: {fast} vs {slow}", m.name);
             }
         }
@@ -161,15 +164,15 @@ proptest! {
         let models = MONOTONE.with(|m| m.clone());
         let t = history.last_time().unwrap_or(0) + extra_t;
         for m in &models {
-            let before = m.predict(wl0, &history, t).unwrap();
-            let after = m.predict_if_queried(wl0, &history, t, kind).unwrap();
+            let before = m.predict(&WorkloadInput::new(wl0, &history, t)).unwrap();
+            let after = m.predict_if_queried(&WorkloadInput::new(wl0, &history, t), kind).unwrap();
             prop_assert!(before.is_finite() && after.is_finite());
             prop_assert!(after >= before, "{}: {} -> {}", m.name, before, after);
             // also a query inserted in the past (at the last query's time)
             let mut h = history.clone();
             if let Some(last) = history.last_time() {
                 h.push(last, kind).unwrap();
-                prop_assert!(m.predict(wl0, &h, t).unwrap() >= before);
+                prop_assert!(m.predict(&WorkloadInput::new(wl0, &h, t)).unwrap() >= before);
             }
         }
     }
@@ -186,9 +189,9 @@ proptest! {
         let back = FittedModel::from_json(&f.to_json(), "r.json".as_ref()).unwrap();
         prop_assert_eq!(&back, &f);
         let t = history.last_time().unwrap_or(0);
-        let a = f.predict(wl0, &history, t).unwrap();
+        let a = f.predict(&WorkloadInput::new(wl0, &history, t)).unwrap();
         prop_assert!(a.is_finite() && (0.0..=1.0).contains(&a));
-        prop_assert_eq!(a.to_bits(), back.predict(wl0, &history, t).unwrap().to_bits());
+        prop_assert_eq!(a.to_bits(), back.predict(&WorkloadInput::new(wl0, &history, t)).unwrap().to_bits());
     }
 }
 
@@ -200,6 +203,13 @@ thread_local! {
 fn empty_history_of_the_constant_model_is_wl0() {
     let d = small_d12();
     let m = fitted(&d).remove(0);
-    assert_eq!(m.predict(0.3, &QueryHistory::new(), 0).unwrap(), 0.3);
-    assert!(m.predict(1.5, &QueryHistory::new(), 0).is_err());
+    assert_eq!(
+        m.predict(&WorkloadInput::new(0.3, &QueryHistory::new(), 0))
+            .unwrap(),
+        0.3
+    );
+    assert!(
+        m.predict(&WorkloadInput::new(1.5, &QueryHistory::new(), 0))
+            .is_err()
+    );
 }

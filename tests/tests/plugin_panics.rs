@@ -2,6 +2,7 @@
 //! is an error (or, for methods that cannot fail, a poisoned object whose
 //! next fallible call is an error), and the host process carries on.
 
+use hil_core::WorkloadInput;
 mod common;
 
 use hil_core::plugin::{self, Params};
@@ -160,15 +161,15 @@ fn workload_model_panics_are_errors() {
     assert_panicked(build("name"), "name");
     let h = QueryHistory::new();
     let m = build("predict").unwrap();
-    assert_panicked(m.predict(0.5, &h, 1), "predict");
+    assert_panicked(m.predict(&WorkloadInput::new(0.5, &h, 1)), "predict");
     assert_poisoned(
-        m.predict_if_queried(0.5, &h, 1, QueryKind::default()),
+        m.predict_if_queried(&WorkloadInput::new(0.5, &h, 1), QueryKind::default()),
         "predict",
     );
     let m = build("predict_if_queried").unwrap();
-    assert_eq!(m.predict(0.5, &h, 1).unwrap(), 0.5);
+    assert_eq!(m.predict(&WorkloadInput::new(0.5, &h, 1)).unwrap(), 0.5);
     assert_panicked(
-        m.predict_if_queried(0.5, &h, 1, QueryKind::default()),
+        m.predict_if_queried(&WorkloadInput::new(0.5, &h, 1), QueryKind::default()),
         "predict_if_queried",
     );
     drop(build("drop").unwrap());

@@ -16,13 +16,14 @@
 //! let m = Fatigue::new(FatigueParams::default()).unwrap();
 //! let mut h = QueryHistory::new();
 //! h.push(1, QueryKind::default()).unwrap();
-//! let just_after = m.predict(0.3, &h, 1).unwrap();
-//! let later = m.predict(0.3, &h, 40).unwrap();
+//! let just_after = m.predict(&WorkloadInput::new(0.3, &h, 1)).unwrap();
+//! let later = m.predict(&WorkloadInput::new(0.3, &h, 40)).unwrap();
 //! assert!(just_after > later && later > 0.3);
 //! ```
 
 use serde::{Deserialize, Serialize};
 
+use hil_core::WorkloadInput;
 use hil_core::plugin::{Params, Registrar};
 use hil_core::workload::check_wl0;
 use hil_core::{
@@ -131,9 +132,9 @@ impl WorkloadModel for Fatigue {
     fn name(&self) -> &str {
         NAME
     }
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        check_wl0(wl0)?;
-        Ok((wl0 + self.fatigue(history, t)).clamp(0.0, 1.0))
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        check_wl0(input.wl0)?;
+        Ok((input.wl0 + self.fatigue(input.history, input.t)).clamp(0.0, 1.0))
     }
 }
 

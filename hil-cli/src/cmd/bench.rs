@@ -12,6 +12,7 @@
 //! traffic (bytes per step, the bandwidth floor) is known only for the
 //! built-in estimator and is reported as absent for other policies.
 
+use hil_core::WorkloadInput;
 mod reproduce;
 mod spec;
 
@@ -154,9 +155,14 @@ impl WorkloadModel for PerQuery {
     fn name(&self) -> &str {
         "per_query"
     }
-    fn predict(&self, wl0: f64, h: &QueryHistory, t: Timestep) -> Result<f64> {
-        let n = h.records().iter().filter(|r| r.t <= t).count();
-        Ok((wl0 + 0.05 * n as f64).min(1.0))
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        let n = input
+            .history
+            .records()
+            .iter()
+            .filter(|r| r.t <= input.t)
+            .count();
+        Ok((input.wl0 + 0.05 * n as f64).min(1.0))
     }
 }
 

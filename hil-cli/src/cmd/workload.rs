@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use hil_core::WorkloadInput;
 use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadModel};
 use hil_workload::bundle::{StudySummary, build_bundle, bundled_study};
 use hil_workload::datasets::{Dataset, DatasetId};
@@ -311,7 +312,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                     asked.push(queries[qi].1.to_string());
                     qi += 1;
                 }
-                let wl = m.predict(wl0, &history, t)?;
+                let wl = m.predict(&WorkloadInput::new(wl0, &history, t))?;
                 println!("{t},{},{wl:.4},{}", t * 10, asked.join(" "));
                 points.push((t, wl, !asked.is_empty()));
             }

@@ -31,7 +31,7 @@ use serde_json::Value;
 use crate::error::{HilError, Result};
 use crate::{
     ActionSpace, ArmId, Context, Decision, DecisionInput, Environment, Feedback, Item, Outcome,
-    Policy, Query, QueryChannel, QueryHistory, QueryKind, Response, Timestep, WorkloadModel,
+    Policy, Query, QueryChannel, QueryKind, Response, WorkloadInput, WorkloadModel,
 };
 
 /// The message of a panic payload.
@@ -357,19 +357,11 @@ impl WorkloadModel for GuardedWorkload {
     fn name(&self) -> &str {
         &self.name
     }
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        self.call("predict", |m| m.predict(wl0, history, t))
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        self.call("predict", |m| m.predict(input))
     }
-    fn predict_if_queried(
-        &self,
-        wl0: f64,
-        history: &QueryHistory,
-        t: Timestep,
-        kind: QueryKind,
-    ) -> Result<f64> {
-        self.call("predict_if_queried", |m| {
-            m.predict_if_queried(wl0, history, t, kind)
-        })
+    fn predict_if_queried(&self, input: &WorkloadInput<'_>, kind: QueryKind) -> Result<f64> {
+        self.call("predict_if_queried", |m| m.predict_if_queried(input, kind))
     }
 }
 

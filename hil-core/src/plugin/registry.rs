@@ -281,7 +281,7 @@ impl PluginRegistrar for HostRegistrar {
 /// use std::path::Path;
 /// use hil_core::plugin::{self, ComponentKind, Params};
 /// use hil_core::testing::fixtures::CountingWorkload;
-/// use hil_core::{BuildContext, QueryHistory};
+/// use hil_core::{BuildContext, QueryHistory, WorkloadInput};
 ///
 /// plugin::register_static(Path::new("doc-example"), |r| {
 ///     r.workload_model("doc_counting", "a step per query", |_p, _ctx| {
@@ -291,7 +291,7 @@ impl PluginRegistrar for HostRegistrar {
 /// .unwrap();
 /// assert!(plugin::is_registered(ComponentKind::WorkloadModel, "doc_counting"));
 /// let m = plugin::build_workload_model("doc_counting", &Params::empty(), &BuildContext::new(".", 0)).unwrap();
-/// assert_eq!(m.predict(0.5, &QueryHistory::new(), 0).unwrap(), 0.5);
+/// assert_eq!(m.predict(&WorkloadInput::new(0.5, &QueryHistory::new(), 0)).unwrap(), 0.5);
 /// let e = plugin::build_workload_model("doc_countin", &Params::empty(), &BuildContext::new(".", 0));
 /// assert!(e.err().unwrap().to_string().contains("closest: `doc_counting`"));
 /// ```

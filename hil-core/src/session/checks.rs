@@ -13,7 +13,7 @@ use crate::decision::Diagnostics;
 use crate::error::{HilError, Result};
 use crate::query::{QueryKind, Response};
 use crate::time::Timestep;
-use crate::workload::{QueryHistory, WorkloadModel};
+use crate::workload::{WorkloadInput, WorkloadModel};
 
 /// Every diagnostic of a policy's decision must be finite. Runs at every
 /// step, so it allocates only to name a bad field.
@@ -77,19 +77,13 @@ impl WorkloadModel for CheckedWorkload {
         self.0.name()
     }
 
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        self.check(self.0.predict(wl0, history, t)?, t, "predict")
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        self.check(self.0.predict(input)?, input.t, "predict")
     }
 
-    fn predict_if_queried(
-        &self,
-        wl0: f64,
-        history: &QueryHistory,
-        t: Timestep,
-        kind: QueryKind,
-    ) -> Result<f64> {
-        let wl = self.0.predict_if_queried(wl0, history, t, kind)?;
-        self.check(wl, t, "predict_if_queried")
+    fn predict_if_queried(&self, input: &WorkloadInput<'_>, kind: QueryKind) -> Result<f64> {
+        let wl = self.0.predict_if_queried(input, kind)?;
+        self.check(wl, input.t, "predict_if_queried")
     }
 }
 

@@ -8,7 +8,7 @@ use serde_json::{Value, json};
 
 use crate::{
     ActionSpace, ArmId, CallOrder, Choice, Context, Decision, DecisionInput, Environment, Feedback,
-    HilError, Item, Outcome, Policy, QueryHistory, Result, Timestep, WorkloadModel,
+    HilError, Item, Outcome, Policy, Result, Timestep, WorkloadInput, WorkloadModel,
 };
 
 /// An environment whose items have fixed per-arm success probabilities.
@@ -243,8 +243,13 @@ impl WorkloadModel for CountingWorkload {
     fn name(&self) -> &str {
         "counting"
     }
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        let n = history.records().iter().filter(|r| r.t <= t).count();
-        Ok((wl0 + self.increment * n as f64).clamp(0.0, 1.0))
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        let n = input
+            .history
+            .records()
+            .iter()
+            .filter(|r| r.t <= input.t)
+            .count();
+        Ok((input.wl0 + self.increment * n as f64).clamp(0.0, 1.0))
     }
 }

@@ -3,7 +3,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
 use super::strategies::query_history;
 use super::{Checker, ConformanceFailure, ConformanceReport};
-use crate::{QueryKind, WorkloadModel};
+use crate::{QueryKind, WorkloadInput, WorkloadModel};
 
 /// Runs the workload-model conformance suite.
 ///
@@ -22,7 +22,10 @@ pub fn check_workload_model(
     let strategy = query_history(40, 400);
     let empty = crate::QueryHistory::new();
     for wl0 in [0.0, 0.25, 0.5, 0.75, 1.0] {
-        let p = c.ok("empty history", model.predict(wl0, &empty, 0))?;
+        let p = c.ok(
+            "empty history",
+            model.predict(&WorkloadInput::new(wl0, &empty, 0)),
+        )?;
         c.check("finite", p.is_finite(), || {
             format!("WL_0 = {wl0}, empty history: {p}")
         })?;
@@ -34,11 +37,17 @@ pub fn check_workload_model(
             .current();
         let t = history.last_time().unwrap_or(0) + 3;
         for wl0 in [0.0, 0.25, 0.5, 0.75, 1.0] {
-            let p = c.ok("predict", model.predict(wl0, &history, t))?;
+            let p = c.ok(
+                "predict",
+                model.predict(&WorkloadInput::new(wl0, &history, t)),
+            )?;
             c.check("finite", p.is_finite(), || {
                 format!("WL_0 = {wl0}, {} queries, t = {t}: {p}", history.len())
             })?;
-            let q = c.ok("predict", model.predict(wl0, &history, t))?;
+            let q = c.ok(
+                "predict",
+                model.predict(&WorkloadInput::new(wl0, &history, t)),
+            )?;
             c.check("deterministic", p.to_bits() == q.to_bits(), || {
                 format!("{p} then {q}")
             })?;
@@ -52,11 +61,14 @@ pub fn check_workload_model(
             ] {
                 let cf = c.ok(
                     "counterfactual",
-                    model.predict_if_queried(wl0, &history, t, kind),
+                    model.predict_if_queried(&WorkloadInput::new(wl0, &history, t), kind),
                 )?;
                 let mut h = history.clone();
                 c.ok("counterfactual", h.push(t, kind))?;
-                let direct = c.ok("counterfactual", model.predict(wl0, &h, t))?;
+                let direct = c.ok(
+                    "counterfactual",
+                    model.predict(&WorkloadInput::new(wl0, &h, t)),
+                )?;
                 c.check(
                     "counterfactual",
                     (cf - direct).abs() <= 1e-12 * (1.0 + direct.abs()),

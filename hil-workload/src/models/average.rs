@@ -1,9 +1,10 @@
 //! The Average baseline: the mean WL_0 of the training set.
 
-use hil_core::{HilError, QueryHistory, Result, Timestep, WorkloadModel, workload::check_wl0};
+use hil_core::{HilError, Result, WorkloadModel, workload::check_wl0};
 use serde::{Deserialize, Serialize};
 
 use crate::datasets::TrainingPair;
+use hil_core::WorkloadInput;
 
 /// Predicts the training set's mean initial workload, whatever happens.
 ///
@@ -11,7 +12,7 @@ use crate::datasets::TrainingPair;
 /// use hil_core::{QueryHistory, WorkloadModel};
 /// use hil_workload::models::AverageModel;
 /// let m = AverageModel { value: 0.4 };
-/// assert_eq!(m.predict(0.9, &QueryHistory::new(), 5).unwrap(), 0.4);
+/// assert_eq!(m.predict(&WorkloadInput::new(0.9, &QueryHistory::new(), 5)).unwrap(), 0.4);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -46,8 +47,8 @@ impl WorkloadModel for AverageModel {
         "average"
     }
 
-    fn predict(&self, wl0: f64, _history: &QueryHistory, _t: Timestep) -> Result<f64> {
-        check_wl0(wl0)?;
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        check_wl0(input.wl0)?;
         Ok(self.value)
     }
 }

@@ -1,6 +1,7 @@
 //! The Constant baseline: WL_t = WL_0.
 
-use hil_core::{QueryHistory, Result, Timestep, WorkloadModel, workload::check_wl0};
+use hil_core::WorkloadInput;
+use hil_core::{Result, WorkloadModel, workload::check_wl0};
 use serde::{Deserialize, Serialize};
 
 /// Predicts that workload never changes: WL_t = WL_0.
@@ -8,7 +9,7 @@ use serde::{Deserialize, Serialize};
 /// ```
 /// use hil_core::{QueryHistory, WorkloadModel};
 /// use hil_workload::models::ConstantModel;
-/// assert_eq!(ConstantModel {}.predict(0.3, &QueryHistory::new(), 5).unwrap(), 0.3);
+/// assert_eq!(ConstantModel {}.predict(&WorkloadInput::new(0.3, &QueryHistory::new(), 5)).unwrap(), 0.3);
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -19,8 +20,8 @@ impl WorkloadModel for ConstantModel {
         "constant"
     }
 
-    fn predict(&self, wl0: f64, _history: &QueryHistory, _t: Timestep) -> Result<f64> {
-        check_wl0(wl0)?;
-        Ok(wl0)
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        check_wl0(input.wl0)?;
+        Ok(input.wl0)
     }
 }

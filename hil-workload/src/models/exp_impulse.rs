@@ -10,6 +10,7 @@ use crate::datasets::TrainingPair;
 use crate::features::SparseRow;
 use crate::features::{KIND_FEATURES, one_hot_indices};
 use crate::fit::{BoxLsq, Gram};
+use hil_core::WorkloadInput;
 
 /// A fitted Exp-Impulse model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -150,8 +151,10 @@ impl WorkloadModel for ExpImpulseModel {
         "exp_impulse"
     }
 
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        check_wl0(wl0)?;
-        Ok(self.linear(wl0, history, t).clamp(0.0, 1.0))
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        check_wl0(input.wl0)?;
+        Ok(self
+            .linear(input.wl0, input.history, input.t)
+            .clamp(0.0, 1.0))
     }
 }

@@ -13,6 +13,7 @@ use hil_core::{HilError, QueryHistory, Result, Timestep, WorkloadModel, workload
 use serde::{Deserialize, Serialize};
 
 use crate::features::{KIND_FEATURES, LEAD_COLUMNS, n_columns, one_hot_indices};
+use hil_core::WorkloadInput;
 
 /// The four variants of the paper plus its simulation variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -222,8 +223,10 @@ impl WorkloadModel for GrangerModel {
         self.variant.key()
     }
 
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        check_wl0(wl0)?;
-        Ok(self.linear(wl0, history, t).clamp(0.0, 1.0))
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        check_wl0(input.wl0)?;
+        Ok(self
+            .linear(input.wl0, input.history, input.t)
+            .clamp(0.0, 1.0))
     }
 }

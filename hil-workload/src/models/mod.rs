@@ -5,6 +5,7 @@
 //! Loading checks the format and version first, so a file from another
 //! version is a clear error rather than a confusing field mismatch.
 
+use hil_core::WorkloadInput;
 pub mod average;
 pub mod constant;
 pub mod exp_impulse;
@@ -12,7 +13,7 @@ pub mod granger;
 
 use std::path::Path;
 
-use hil_core::{HilError, QueryHistory, Result, Timestep, WorkloadModel};
+use hil_core::{HilError, Result, WorkloadModel};
 use serde::{Deserialize, Serialize};
 
 pub use average::AverageModel;
@@ -211,7 +212,7 @@ impl WorkloadModel for FittedModel {
         &self.name
     }
 
-    fn predict(&self, wl0: f64, history: &QueryHistory, t: Timestep) -> Result<f64> {
-        self.spec.as_model().predict(wl0, history, t)
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
+        self.spec.as_model().predict(input)
     }
 }

@@ -5,11 +5,11 @@
 use serde::Deserialize;
 use serde_json::Value;
 
+use hil_core::WorkloadInput;
 use hil_core::plugin::{Params, Registrar};
 use hil_core::{
     ActionSpace, ArmId, Context, Decision, DecisionInput, Environment, Feedback, Item, Outcome,
-    Policy, Query, QueryChannel, QueryHistory, QueryKind, Response, Result, Timestep,
-    WorkloadModel,
+    Policy, Query, QueryChannel, QueryKind, Response, Result, WorkloadModel,
 };
 
 #[derive(Deserialize)]
@@ -137,19 +137,13 @@ impl WorkloadModel for Panicky {
         self.maybe("name");
         "panicky_workload"
     }
-    fn predict(&self, wl0: f64, _history: &QueryHistory, _t: Timestep) -> Result<f64> {
+    fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
         self.maybe("predict");
-        Ok(wl0)
+        Ok(input.wl0)
     }
-    fn predict_if_queried(
-        &self,
-        wl0: f64,
-        _history: &QueryHistory,
-        _t: Timestep,
-        _kind: QueryKind,
-    ) -> Result<f64> {
+    fn predict_if_queried(&self, input: &WorkloadInput<'_>, _kind: QueryKind) -> Result<f64> {
         self.maybe("predict_if_queried");
-        Ok(wl0)
+        Ok(input.wl0)
     }
 }
 

@@ -81,7 +81,7 @@ pub fn load_fitted(name: &str) -> Result<FittedModel> {
 /// Loads a bundled model.
 ///
 /// ```
-/// use hil_core::{QueryHistory, QueryKind, WorkloadModel};
+/// use hil_core::{QueryHistory, QueryKind, WorkloadInput, WorkloadModel};
 /// let m = hil_workload::bundled::load("f1_sim").unwrap();
 /// let mut h = QueryHistory::new();
 /// let before = m.predict(&WorkloadInput::new(0.5, &h, 3)).unwrap();

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use hil_core::WorkloadInput;
 use hil_core::config::{WorkloadModelConfig, limits};
-use hil_core::{BuildContext, HilError, QueryHistory, Result, WorkloadModel};
+use hil_core::{BuildContext, HilError, Result, WorkloadModel};
 
 /// Config of the demo workload model, `type = "demo_counting"`:
 ///
@@ -22,7 +22,7 @@ use hil_core::{BuildContext, HilError, QueryHistory, Result, WorkloadModel};
 /// ```
 ///
 /// ```
-/// use hil_core::{QueryHistory, QueryKind, WorkloadModel};
+/// use hil_core::{QueryHistory, QueryKind, WorkloadInput, WorkloadModel};
 /// use hil_workload::demo_counting::DemoCounting;
 ///
 /// let model = DemoCounting { increment: 0.1, window: 10 };
@@ -74,7 +74,7 @@ impl WorkloadModel for DemoCounting {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hil_core::QueryKind;
+    use hil_core::{QueryHistory, QueryKind};
 
     #[test]
     fn the_demo_workload_conforms() {

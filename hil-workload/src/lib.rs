@@ -20,7 +20,7 @@
 //! Bundled data and models are synthetic, calibrated to published figures.
 //!
 //! ```
-//! use hil_core::{QueryHistory, QueryKind, WorkloadModel};
+//! use hil_core::{QueryHistory, QueryKind, WorkloadInput, WorkloadModel};
 //! let model = hil_workload::bundled::load("f12_real").unwrap();
 //! let mut history = QueryHistory::new();
 //! history.push(1, QueryKind::default()).unwrap();

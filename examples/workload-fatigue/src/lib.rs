@@ -11,7 +11,7 @@
 //! (Δt = 10 s), so the default τ = 12 recovers by 1/e in two minutes.
 //!
 //! ```
-//! use hil_core::{QueryHistory, QueryKind, WorkloadModel};
+//! use hil_core::{QueryHistory, QueryKind, WorkloadInput, WorkloadModel};
 //! use hil_example_workload_fatigue::{Fatigue, FatigueParams};
 //! let m = Fatigue::new(FatigueParams::default()).unwrap();
 //! let mut h = QueryHistory::new();

@@ -9,7 +9,7 @@ use hil_core::WorkloadInput;
 /// Predicts the training set's mean initial workload, whatever happens.
 ///
 /// ```
-/// use hil_core::{QueryHistory, WorkloadModel};
+/// use hil_core::{QueryHistory, WorkloadInput, WorkloadModel};
 /// use hil_workload::models::AverageModel;
 /// let m = AverageModel { value: 0.4 };
 /// assert_eq!(m.predict(&WorkloadInput::new(0.9, &QueryHistory::new(), 5)).unwrap(), 0.4);

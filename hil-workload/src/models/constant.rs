@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 /// Predicts that workload never changes: WL_t = WL_0.
 ///
 /// ```
-/// use hil_core::{QueryHistory, WorkloadModel};
+/// use hil_core::{QueryHistory, WorkloadInput, WorkloadModel};
 /// use hil_workload::models::ConstantModel;
 /// assert_eq!(ConstantModel {}.predict(&WorkloadInput::new(0.3, &QueryHistory::new(), 5)).unwrap(), 0.3);
 /// ```

@@ -200,11 +200,7 @@ impl QueryChannel for SimulatedExpert {
         let response_time_s = self.params.response_time.map(|m| m.sample(&mut rng));
 
         if declines {
-            return Ok(Response {
-                answer: Answer::Declined,
-                expert_arm: None,
-                response_time_s,
-            });
+            return Ok(Response::new(Answer::Declined, None, response_time_s));
         }
         let arm = if errs && query.actions.len() > 1 {
             // Uniform over the actions other than the best one.
@@ -215,21 +211,17 @@ impl QueryChannel for SimulatedExpert {
         let answer = match query.kind.response {
             ResponseType::Mcq => Answer::Action { arm },
             ResponseType::BoundingBox => Answer::BoundingBox {
-                bbox: BoundingBox {
-                    x0: 0.35 + jitter[0],
-                    y0: 0.35 + jitter[1],
-                    x1: 0.65 + jitter[2],
-                    y1: 0.65 + jitter[3],
-                },
+                bbox: BoundingBox::new(
+                    0.35 + jitter[0],
+                    0.35 + jitter[1],
+                    0.65 + jitter[2],
+                    0.65 + jitter[3],
+                ),
             },
             ResponseType::OpenEnded => Answer::Text {
                 text: format!("try {}", query.actions.name(arm)?),
             },
         };
-        Ok(Response {
-            answer,
-            expert_arm: Some(arm),
-            response_time_s,
-        })
+        Ok(Response::new(answer, Some(arm), response_time_s))
     }
 }

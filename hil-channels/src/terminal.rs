@@ -178,12 +178,7 @@ impl<R: BufRead, W: Write> TerminalChannel<R, W> {
                     .collect();
                 match nums.as_deref() {
                     Ok([x0, y0, x1, y1]) => {
-                        let bbox = BoundingBox {
-                            x0: *x0,
-                            y0: *y0,
-                            x1: *x1,
-                            y1: *y1,
-                        };
+                        let bbox = BoundingBox::new(*x0, *y0, *x1, *y1);
                         match check_bbox(&bbox) {
                             Ok(()) => Parsed::Answer(Answer::BoundingBox { bbox }),
                             Err(why) => Parsed::Retry(why),
@@ -233,11 +228,8 @@ impl<R: BufRead + Send, W: Write + Send> QueryChannel for TerminalChannel<R, W> 
             match Self::parse(query, &line) {
                 Parsed::Answer(answer) => {
                     let expert_arm = validate_answer(query, &answer)?;
-                    return Ok(Response {
-                        answer,
-                        expert_arm,
-                        response_time_s: Some(start.elapsed().as_secs_f64()),
-                    });
+                    let seconds = start.elapsed().as_secs_f64();
+                    return Ok(Response::new(answer, expert_arm, Some(seconds)));
                 }
                 Parsed::Retry(why) => {
                     writeln!(self.output, "  {why}").map_err(|e| self.io_err(e))?;

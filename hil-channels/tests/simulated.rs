@@ -10,21 +10,17 @@ use hil_core::{
 };
 
 fn query(t: u64, best: usize, response: ResponseType) -> Query {
-    Query {
+    Query::new(
         t,
-        item: Item {
-            index: 0,
-            label: "carrot".into(),
-            description: None,
-        },
-        kind: QueryKind {
+        Item::new(0, "carrot"),
+        QueryKind {
             response,
             ..Default::default()
         },
-        actions: hil_envs::feeding::action_space(),
-        context: Context::new(vec![1.0, 0.0]).unwrap(),
-        oracle_best: Some(ArmId(best)),
-    }
+        hil_envs::feeding::action_space(),
+        Context::new(vec![1.0, 0.0]).unwrap(),
+    )
+    .with_oracle_best(ArmId(best))
 }
 
 /// The simulated expert with default parameters: the paper's perfect expert.

@@ -9,22 +9,18 @@ use hil_core::{
 };
 
 fn query(response: ResponseType) -> Query {
-    Query {
-        t: 4,
-        item: Item {
-            index: 2,
-            label: "bell_pepper".into(),
-            description: Some("a strip of bell pepper".into()),
-        },
-        kind: QueryKind {
+    Query::new(
+        4,
+        Item::new(2, "bell_pepper").with_description("a strip of bell pepper"),
+        QueryKind {
             response,
             difficulty: Difficulty::Hard,
             distraction: Distraction::Easy,
         },
-        actions: hil_envs::feeding::action_space(),
-        context: Context::new(vec![0.5, 0.5]).unwrap(),
-        oracle_best: Some(ArmId(5)),
-    }
+        hil_envs::feeding::action_space(),
+        Context::new(vec![0.5, 0.5]).unwrap(),
+    )
+    .with_oracle_best(ArmId(5))
 }
 
 fn ask(input: &str, response: ResponseType) -> (hil_core::Result<hil_core::Response>, String) {
@@ -84,12 +80,7 @@ fn bounding_box_is_validated() {
     assert_eq!(
         r.answer,
         Answer::BoundingBox {
-            bbox: BoundingBox {
-                x0: 0.2,
-                y0: 0.3,
-                x1: 0.7,
-                y1: 0.8
-            }
+            bbox: BoundingBox::new(0.2, 0.3, 0.7, 0.8)
         }
     );
     assert_eq!(

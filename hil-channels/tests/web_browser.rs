@@ -259,22 +259,18 @@ impl Drop for Browser {
 }
 
 fn query(t: u64, response: ResponseType) -> Query {
-    Query {
+    Query::new(
         t,
-        item: Item {
-            index: t as usize,
-            label: "baby_carrot".into(),
-            description: Some("a baby carrot lying flat".into()),
-        },
-        kind: QueryKind {
+        Item::new(t as usize, "baby_carrot").with_description("a baby carrot lying flat"),
+        QueryKind {
             response,
             difficulty: Difficulty::Hard,
             distraction: Distraction::Easy,
         },
-        actions: hil_envs::feeding::action_space(),
-        context: Context::new(vec![0.0]).unwrap(),
-        oracle_best: Some(ArmId(5)),
-    }
+        hil_envs::feeding::action_space(),
+        Context::new(vec![0.0]).unwrap(),
+    )
+    .with_oracle_best(ArmId(5))
 }
 
 fn ask_async(mut ch: WebChannel, q: Query) -> JoinHandle<(WebChannel, Response)> {

@@ -35,10 +35,7 @@ fn step(t: u64) -> StepEvent {
             arm: ArmId(2),
             wl_t: 0.5,
         },
-        outcome: Outcome {
-            success: true,
-            success_probability: Some(0.7),
-        },
+        outcome: Outcome::new(true).with_success_probability(0.7),
     }
 }
 

@@ -1,5 +1,7 @@
 //! What a policy decides at one timestep, and why.
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 
 use crate::action::ArmId;
@@ -26,6 +28,7 @@ pub enum Choice {
 
 /// Per-arm numbers behind a decision, for logs and plots.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct ArmDiagnostics {
     /// Estimated reward θᵀx.
     pub estimate: f64,
@@ -35,9 +38,78 @@ pub struct ArmDiagnostics {
     pub ucb: f64,
 }
 
-/// Why a policy decided what it did. Every field is optional so that
-/// policies without a given quantity simply leave it out.
+impl ArmDiagnostics {
+    /// An arm's estimate, confidence width and upper bound.
+    pub fn new(estimate: f64, bonus: f64, ucb: f64) -> Self {
+        Self {
+            estimate,
+            bonus,
+            ucb,
+        }
+    }
+}
+
+/// A component's own named numbers, for what the shared fields do not
+/// name: a Thompson-sampling policy's agreement between posterior draws, an
+/// environment's contact force. Logged with the step, checked to be finite
+/// by the session loop, and never read by hil's own code, so a new quantity
+/// needs no change to hil.
+///
+/// ```
+/// use hil_core::Extras;
+/// let x = Extras::new().with("agreement", 0.8);
+/// assert_eq!(x.get("agreement"), Some(0.8));
+/// assert_eq!(x.get("gap"), None);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct Extras(BTreeMap<String, f64>);
+
+impl Extras {
+    /// No values.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// These values and `name` = `value` (replacing an earlier one).
+    pub fn with(mut self, name: impl Into<String>, value: f64) -> Self {
+        self.insert(name, value);
+        self
+    }
+
+    /// Sets `name` to `value`.
+    pub fn insert(&mut self, name: impl Into<String>, value: f64) {
+        self.0.insert(name.into(), value);
+    }
+
+    /// The value under `name`.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.0.get(name).copied()
+    }
+
+    /// The values in name order.
+    pub fn iter(&self) -> impl Iterator<Item = (&str, f64)> {
+        self.0.iter().map(|(k, v)| (k.as_str(), *v))
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+/// Why a policy decided what it did. Every field is optional so that
+/// policies without a given quantity simply leave it out; a policy's own
+/// quantities go in [`Diagnostics::extra`], never in a field that means
+/// something else.
+///
+/// ```
+/// use hil_core::Diagnostics;
+/// let d = Diagnostics::new().with_gap(0.4).with_threshold(0.1).with_extra("agreement", 0.9);
+/// assert_eq!((d.gap, d.extra.get("agreement")), (Some(0.4), Some(0.9)));
+/// ```
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Diagnostics {
     /// One entry per arm, for estimator-based policies.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -54,6 +126,52 @@ pub struct Diagnostics {
     /// The workload forecast the policy used, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub workload_forecast: Option<f64>,
+    /// The policy's own quantities.
+    #[serde(default, skip_serializing_if = "Extras::is_empty")]
+    pub extra: Extras,
+}
+
+impl Diagnostics {
+    /// No diagnostics.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// With per-arm numbers.
+    pub fn with_arms(mut self, arms: Vec<ArmDiagnostics>) -> Self {
+        self.arms = arms;
+        self
+    }
+
+    /// With the query gap G.
+    pub fn with_gap(mut self, gap: f64) -> Self {
+        self.gap = Some(gap);
+        self
+    }
+
+    /// With the threshold the gap was compared against.
+    pub fn with_threshold(mut self, threshold: f64) -> Self {
+        self.threshold = Some(threshold);
+        self
+    }
+
+    /// With the probability of querying.
+    pub fn with_query_probability(mut self, p: f64) -> Self {
+        self.query_probability = Some(p);
+        self
+    }
+
+    /// With the workload forecast used (none if `None`).
+    pub fn with_workload_forecast(mut self, forecast: Option<f64>) -> Self {
+        self.workload_forecast = forecast;
+        self
+    }
+
+    /// With one of the policy's own quantities.
+    pub fn with_extra(mut self, name: impl Into<String>, value: f64) -> Self {
+        self.extra.insert(name, value);
+        self
+    }
 }
 
 /// A policy's decision with its diagnostics.
@@ -90,7 +208,14 @@ impl Decision {
 }
 
 /// The result of executing a robot action.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// ```
+/// use hil_core::Outcome;
+/// let o = Outcome::new(true).with_success_probability(0.7).with_extra("force_n", 2.5);
+/// assert_eq!((o.reward(), o.task_reward(), o.extra.get("force_n")), (1.0, 0.7, Some(2.5)));
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Outcome {
     /// Whether the attempt succeeded (the reward).
     pub success: bool,
@@ -98,9 +223,33 @@ pub struct Outcome {
     /// environment knows it (simulation). Metrics use it as the expected task
     /// reward r_task; otherwise they use `success` as 0/1.
     pub success_probability: Option<f64>,
+    /// The environment's own quantities (e.g. a simulator's contact force).
+    #[serde(default, skip_serializing_if = "Extras::is_empty")]
+    pub extra: Extras,
 }
 
 impl Outcome {
+    /// A success or failure whose probability is not known.
+    pub fn new(success: bool) -> Self {
+        Self {
+            success,
+            success_probability: None,
+            extra: Extras::default(),
+        }
+    }
+
+    /// With the probability that the action succeeds in this context.
+    pub fn with_success_probability(mut self, p: f64) -> Self {
+        self.success_probability = Some(p);
+        self
+    }
+
+    /// With one of the environment's own quantities.
+    pub fn with_extra(mut self, name: impl Into<String>, value: f64) -> Self {
+        self.extra.insert(name, value);
+        self
+    }
+
     /// The reward as 0.0 / 1.0.
     pub fn reward(&self) -> f64 {
         if self.success { 1.0 } else { 0.0 }

@@ -49,7 +49,9 @@ pub use action::{ActionSpace, ArmId};
 pub use channel::{PerfectExpert, QueryChannel};
 pub use config::{BuildContext, BuildMemo, ConfigError, ExperimentConfig};
 pub use context::Context;
-pub use decision::{ArmDiagnostics, Choice, Decision, Diagnostics, LabelledObservation, Outcome};
+pub use decision::{
+    ArmDiagnostics, Choice, Decision, Diagnostics, Extras, LabelledObservation, Outcome,
+};
 pub use environment::{CallOrder, Environment, Item};
 pub use error::{HilError, Result};
 pub use experiment::{Experiment, ExperimentSummary};

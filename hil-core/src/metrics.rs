@@ -30,6 +30,7 @@ use crate::workload::{QueryHistory, WorkloadModel, check_wl0, workload_at};
 /// experiment: decide with one model, score with another) is
 /// [`EpisodeMetrics::rescored`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct EpisodeMetrics {
     /// Mean task reward per timestep.
     pub r_task_avg: f64,

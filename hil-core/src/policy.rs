@@ -10,7 +10,16 @@ use crate::time::Timestep;
 use crate::workload::WorkloadForecast;
 
 /// What a policy knows when it decides.
+///
+/// ```
+/// use hil_core::{Context, DecisionInput, QueryHistory, WorkloadForecast};
+/// let x = Context::new(vec![0.5; 3]).unwrap();
+/// let h = QueryHistory::new();
+/// let input = DecisionInput::new(&x, 4, WorkloadForecast::none(&h)).at_item(1, 1, 2);
+/// assert_eq!((input.t, input.item_index, input.items_seen, input.attempt), (4, 1, 1, 2));
+/// ```
 #[derive(Debug)]
+#[non_exhaustive]
 pub struct DecisionInput<'a> {
     /// The context of the current observation.
     pub context: &'a Context,
@@ -26,8 +35,40 @@ pub struct DecisionInput<'a> {
     pub workload: WorkloadForecast<'a>,
 }
 
+impl<'a> DecisionInput<'a> {
+    /// The input at timestep `t` for `context`, at the first attempt at the
+    /// first item of an episode ([`DecisionInput::at_item`] moves it).
+    pub fn new(context: &'a Context, t: Timestep, workload: WorkloadForecast<'a>) -> Self {
+        Self {
+            context,
+            t,
+            item_index: 0,
+            items_seen: 0,
+            attempt: 0,
+            workload,
+        }
+    }
+
+    /// At attempt `attempt` (0-based) of item `item_index` (0-based), after
+    /// `items_seen` earlier items.
+    pub fn at_item(mut self, item_index: usize, items_seen: usize, attempt: u32) -> Self {
+        self.item_index = item_index;
+        self.items_seen = items_seen;
+        self.attempt = attempt;
+        self
+    }
+}
+
 /// What a policy learns from after an attempt.
+///
+/// ```
+/// use hil_core::{ArmId, Context, Feedback};
+/// let x = Context::new(vec![0.5; 3]).unwrap();
+/// let f = Feedback::new(&x, ArmId(2), 1.0, 4).from_expert(true);
+/// assert!(f.from_expert && f.reward == 1.0);
+/// ```
 #[derive(Clone, Copy, Debug)]
+#[non_exhaustive]
 pub struct Feedback<'a> {
     /// The context the attempt was made in.
     pub context: &'a Context,
@@ -39,6 +80,26 @@ pub struct Feedback<'a> {
     pub t: Timestep,
     /// Whether the arm came from a human answer rather than the policy.
     pub from_expert: bool,
+}
+
+impl<'a> Feedback<'a> {
+    /// The reward `reward` seen after executing `arm` in `context` at `t`,
+    /// chosen by the policy (see [`Feedback::from_expert`]).
+    pub fn new(context: &'a Context, arm: ArmId, reward: f64, t: Timestep) -> Self {
+        Self {
+            context,
+            arm,
+            reward,
+            t,
+            from_expert: false,
+        }
+    }
+
+    /// Marks whether the arm came from a human answer.
+    pub fn from_expert(mut self, from_expert: bool) -> Self {
+        self.from_expert = from_expert;
+        self
+    }
 }
 
 /// A contextual-bandit policy with a query action.

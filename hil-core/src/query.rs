@@ -162,6 +162,7 @@ impl std::str::FromStr for QueryKind {
 
 /// Everything a channel needs to pose one query.
 #[derive(Clone, Debug, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Query {
     /// Session timestep of the query.
     pub t: Timestep,
@@ -178,8 +179,44 @@ pub struct Query {
     pub oracle_best: Option<ArmId>,
 }
 
+impl Query {
+    /// A query of `kind` at timestep `t` about `item`, seen as `context`,
+    /// answered from `actions`.
+    ///
+    /// ```
+    /// use hil_core::{ActionSpace, ArmId, Context, Item, Query, QueryKind};
+    /// let q = Query::new(1, Item::new(0, "banana"), QueryKind::default(),
+    ///     ActionSpace::new(["a", "b"]).unwrap(), Context::new(vec![0.0; 4]).unwrap())
+    ///     .with_oracle_best(ArmId(1));
+    /// assert_eq!(q.oracle_best, Some(ArmId(1)));
+    /// ```
+    pub fn new(
+        t: Timestep,
+        item: Item,
+        kind: QueryKind,
+        actions: ActionSpace,
+        context: Context,
+    ) -> Self {
+        Self {
+            t,
+            item,
+            kind,
+            actions,
+            context,
+            oracle_best: None,
+        }
+    }
+
+    /// With the best action, known to a simulated environment.
+    pub fn with_oracle_best(mut self, arm: ArmId) -> Self {
+        self.oracle_best = Some(arm);
+        self
+    }
+}
+
 /// An axis-aligned box in normalised image coordinates (0..1).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct BoundingBox {
     /// Left edge.
     pub x0: f64,
@@ -189,6 +226,13 @@ pub struct BoundingBox {
     pub x1: f64,
     /// Bottom edge.
     pub y1: f64,
+}
+
+impl BoundingBox {
+    /// The box from (`x0`, `y0`) to (`x1`, `y1`), in normalised image coordinates.
+    pub fn new(x0: f64, y0: f64, x1: f64, y1: f64) -> Self {
+        Self { x0, y0, x1, y1 }
+    }
 }
 
 /// What the person answered.
@@ -222,7 +266,14 @@ pub enum Answer {
 }
 
 /// A channel's response to a [`Query`].
+///
+/// ```
+/// use hil_core::{ArmId, Response};
+/// let r = Response::action(ArmId(2)).with_response_time(1.5);
+/// assert_eq!((r.expert_arm, r.response_time_s), (Some(ArmId(2)), Some(1.5)));
+/// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Response {
     /// What the person answered.
     pub answer: Answer,
@@ -234,6 +285,16 @@ pub struct Response {
 }
 
 impl Response {
+    /// `answer`, implying the robot action `expert_arm` (if any), given in
+    /// `response_time_s` seconds (when measured).
+    pub fn new(answer: Answer, expert_arm: Option<ArmId>, response_time_s: Option<f64>) -> Self {
+        Self {
+            answer,
+            expert_arm,
+            response_time_s,
+        }
+    }
+
     /// A response choosing `arm`.
     pub fn action(arm: ArmId) -> Self {
         Self {
@@ -250,5 +311,17 @@ impl Response {
             expert_arm: None,
             response_time_s: None,
         }
+    }
+
+    /// With the robot action the answer implies (e.g. a label mapped to an arm).
+    pub fn with_expert_arm(mut self, arm: ArmId) -> Self {
+        self.expert_arm = Some(arm);
+        self
+    }
+
+    /// With the seconds the person took to answer.
+    pub fn with_response_time(mut self, seconds: f64) -> Self {
+        self.response_time_s = Some(seconds);
+        self
     }
 }

@@ -35,14 +35,7 @@ proptest! {
         let dim = hil_core::Environment::context_dim(&env);
         let mut policy = ScriptedPolicy::new(3, dim, script);
         let mut channel = PerfectExpert::default();
-        let mut s = Session {
-            settings: SessionSettings { n_att, wl0: 0.5, max_items: None },
-            environment: &mut env,
-            policy: &mut policy,
-            channel: &mut channel,
-            workload: Arc::new(CountingWorkload::new(inc)),
-            forecast: None,
-        };
+        let mut s = Session::new(SessionSettings::default().with_n_att(n_att).with_wl0(0.5).with_max_items(None), &mut env, &mut policy, &mut channel, Arc::new(CountingWorkload::new(inc)));
         let r = s.run_episode(seed, &mut []).unwrap();
         let m = &r.metrics;
         prop_assert_eq!(m.n_items, probs.len());

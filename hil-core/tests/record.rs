@@ -83,11 +83,10 @@ fn experiment(asked: Arc<Mutex<Vec<u64>>>) -> Experiment {
         ],
     );
     Experiment {
-        settings: SessionSettings {
-            n_att: 3,
-            wl0: 0.5,
-            max_items: None,
-        },
+        settings: SessionSettings::default()
+            .with_n_att(3)
+            .with_wl0(0.5)
+            .with_max_items(None),
         seed: 42,
         episodes: 3,
         environment: Box::new(env),
@@ -460,14 +459,11 @@ fn a_step_that_cannot_be_logged_stops_the_session_before_the_robot_acts() {
         attempt: 0,
         context: hil_core::Context::new(vec![0.0]).unwrap(),
         decision: StepDecision::Act { arm: ArmId(0) },
-        diagnostics: Some(Diagnostics {
-            arms: vec![ArmDiagnostics {
-                estimate: f64::NAN,
-                bonus: 0.0,
-                ucb: 0.0,
-            }],
-            ..Default::default()
-        }),
+        diagnostics: Some(Diagnostics::new().with_arms(vec![ArmDiagnostics::new(
+            f64::NAN,
+            0.0,
+            0.0,
+        )])),
         response: None,
         arm: ArmId(0),
         wl_t: 0.5,

@@ -49,10 +49,7 @@ fn experiment(seed: u64) -> Experiment {
         fallback: ArmId(0),
     };
     Experiment {
-        settings: SessionSettings {
-            n_att: 3,
-            ..Default::default()
-        },
+        settings: SessionSettings::default().with_n_att(3),
         seed,
         episodes: 3,
         environment: Box::new(env),

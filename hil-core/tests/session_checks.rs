@@ -28,10 +28,7 @@ impl Policy for NanDiagnostics {
     }
     fn decide(&mut self, input: &DecisionInput<'_>) -> hil_core::Result<Decision> {
         let d = self.0.decide(input)?;
-        Ok(d.with_diagnostics(Diagnostics {
-            gap: Some(f64::NAN),
-            ..Default::default()
-        }))
+        Ok(d.with_diagnostics(Diagnostics::new().with_gap(f64::NAN)))
     }
     fn observe(&mut self, feedback: &Feedback<'_>) -> hil_core::Result<()> {
         self.0.observe(feedback)

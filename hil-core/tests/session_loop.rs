@@ -24,14 +24,13 @@ fn episode(
     seed: u64,
     observers: &mut [&mut dyn SessionObserver],
 ) -> EpisodeReport {
-    Session {
+    Session::new(
         settings,
-        environment: env,
+        env,
         policy,
         channel,
-        workload: Arc::new(CountingWorkload::new(inc)),
-        forecast: None,
-    }
+        Arc::new(CountingWorkload::new(inc)),
+    )
     .run_episode(seed, observers)
     .unwrap()
 }
@@ -85,11 +84,10 @@ fn hand_worked_episode() {
         &mut env,
         &mut policy,
         &mut channel,
-        SessionSettings {
-            n_att: 3,
-            wl0: 0.5,
-            max_items: None,
-        },
+        SessionSettings::default()
+            .with_n_att(3)
+            .with_wl0(0.5)
+            .with_max_items(None),
         0.1,
         1,
         &mut [&mut collector],
@@ -192,10 +190,7 @@ fn item_ends_after_n_att_attempts() {
             &mut env,
             &mut policy,
             &mut channel,
-            SessionSettings {
-                n_att,
-                ..Default::default()
-            },
+            SessionSettings::default().with_n_att(n_att),
             0.1,
             3,
             &mut [],
@@ -231,10 +226,7 @@ fn declined_query_falls_back_and_still_costs_workload() {
         &mut env,
         &mut policy,
         &mut channel,
-        SessionSettings {
-            n_att: 3,
-            ..Default::default()
-        },
+        SessionSettings::default().with_n_att(3),
         0.2,
         0,
         &mut [],
@@ -283,14 +275,13 @@ fn shape_mismatch_is_an_error() {
     let mut env = TableEnv::new(actions(), vec![("a", vec![0.3, 0.5, 0.7])]).unwrap();
     let mut policy = ScriptedPolicy::new(3, 99, vec![act(0)]);
     let mut channel = PerfectExpert::default();
-    let mut s = Session {
-        settings: SessionSettings::default(),
-        environment: &mut env,
-        policy: &mut policy,
-        channel: &mut channel,
-        workload: Arc::new(CountingWorkload::new(0.1)),
-        forecast: None,
-    };
+    let mut s = Session::new(
+        SessionSettings::default(),
+        &mut env,
+        &mut policy,
+        &mut channel,
+        Arc::new(CountingWorkload::new(0.1)),
+    );
     let e = s.run_episode(0, &mut []).unwrap_err().to_string();
     assert!(e.contains("d = 99") && e.contains("d = 3"), "{e}");
 }
@@ -386,17 +377,13 @@ fn workload_is_the_models_wl_t_at_every_step_and_scored_at_the_last() {
     let run = |script: Vec<Choice>, n_att: u32| {
         let mut env = TableEnv::new(actions(), vec![("pear", vec![0.0, 0.0, 0.0])]).unwrap();
         let mut policy = ScriptedPolicy::new(3, 3, script);
-        Session {
-            settings: SessionSettings {
-                n_att,
-                ..Default::default()
-            },
-            environment: &mut env,
-            policy: &mut policy,
-            channel: &mut Decliner(0),
-            workload: Arc::new(Decaying),
-            forecast: None,
-        }
+        Session::new(
+            SessionSettings::default().with_n_att(n_att),
+            &mut env,
+            &mut policy,
+            &mut Decliner(0),
+            Arc::new(Decaying),
+        )
         .run_episode(0, &mut [])
         .unwrap()
     };
@@ -439,14 +426,13 @@ fn explicit_component_seeds_reach_each_component() {
             policy: 1,
             channel: 2,
         };
-        let r = Session {
-            settings: SessionSettings::default(),
-            environment: &mut env,
-            policy: &mut policy,
-            channel: &mut channel,
-            workload: Arc::new(CountingWorkload::new(0.1)),
-            forecast: None,
-        }
+        let r = Session::new(
+            SessionSettings::default(),
+            &mut env,
+            &mut policy,
+            &mut channel,
+            Arc::new(CountingWorkload::new(0.1)),
+        )
         .run_episode_with_seeds(label, seeds, &mut [])
         .unwrap();
         assert_eq!(r.seed, label);

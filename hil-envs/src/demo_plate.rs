@@ -190,11 +190,8 @@ impl Environment for DemoPlate {
             return Ok(None);
         };
         let facts = &self.task.foods[food];
-        let item = Item {
-            index: self.next,
-            label: facts.name.clone(),
-            description: Some(facts.description.clone()),
-        };
+        let item =
+            Item::new(self.next, facts.name.clone()).with_description(facts.description.clone());
         self.next += 1;
         self.current = Some((item.clone(), food));
         self.calls.on_next_item(true);
@@ -214,10 +211,7 @@ impl Environment for DemoPlate {
         self.task.action_space().check(arm)?;
         self.calls.on_execute()?;
         let p = self.rates()?[arm.0];
-        Ok(Outcome {
-            success: self.rng.random_bool(p),
-            success_probability: Some(p),
-        })
+        Ok(Outcome::new(self.rng.random_bool(p)).with_success_probability(p))
     }
     fn best_action(&self) -> Option<ArmId> {
         self.food().ok().map(FoodFacts::best_action)

@@ -173,11 +173,10 @@ impl Environment for DatasetReplayEnv {
             self.calls.on_next_item(false);
             return Ok(None);
         }
-        let item = Item {
-            index: self.next,
-            label: self.dataset.foods[self.sequence[self.next]].name.clone(),
-            description: None,
-        };
+        let item = Item::new(
+            self.next,
+            self.dataset.foods[self.sequence[self.next]].name.clone(),
+        );
         self.next += 1;
         self.attempt = 0;
         self.current = Some(item.clone());
@@ -230,10 +229,7 @@ impl Environment for DatasetReplayEnv {
                 ));
             }
         };
-        Ok(Outcome {
-            success,
-            success_probability: Some(p),
-        })
+        Ok(Outcome::new(success).with_success_probability(p))
     }
 
     fn best_action(&self) -> Option<ArmId> {

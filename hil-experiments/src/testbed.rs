@@ -709,14 +709,13 @@ impl Protocol {
         // the tables rescore every run under each model anyway.
         let model = self.models[key.decide_model.unwrap_or(0)].model.clone();
         let (label, seeds) = self.seeds(key);
-        let mut session = Session {
-            settings: s.session.clone(),
-            environment: &mut env,
-            policy: policy.as_mut(),
-            channel: channel.as_mut(),
-            workload: model,
-            forecast: None,
-        };
+        let mut session = Session::new(
+            s.session.clone(),
+            &mut env,
+            policy.as_mut(),
+            channel.as_mut(),
+            model,
+        );
         let report = session.run_episode_with_seeds(label, seeds, &mut [])?;
         let steps = report
             .events

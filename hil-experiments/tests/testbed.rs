@@ -356,14 +356,13 @@ type = "simulated_expert"
     let cfg = hil_core::ExperimentConfig::parse(&text, path).unwrap();
     let mut exp = cfg.build(std::path::Path::new(".")).unwrap();
     let (label, seeds) = p.seeds(&key);
-    let report = hil_core::Session {
-        settings: exp.settings.clone(),
-        environment: exp.environment.as_mut(),
-        policy: exp.policy.as_mut(),
-        channel: exp.channel.as_mut(),
-        workload: exp.workload.clone(),
-        forecast: None,
-    }
+    let report = hil_core::Session::new(
+        exp.settings.clone(),
+        exp.environment.as_mut(),
+        exp.policy.as_mut(),
+        exp.channel.as_mut(),
+        exp.workload.clone(),
+    )
     .run_episode_with_seeds(label, seeds, &mut [])
     .unwrap();
     let m = &report.metrics;

@@ -311,10 +311,7 @@ impl KinovaFeedingEnv {
         let report = self.sim.execute(&ACTIONS[arm.0], &obs.target, keyframe)?;
         let success = report.success;
         self.last = Some(report);
-        Ok(Outcome {
-            success,
-            success_probability: None,
-        })
+        Ok(Outcome::new(success))
     }
 
     /// Lays out the plate for `target` in `setting`: the target first,
@@ -445,11 +442,11 @@ impl Environment for KinovaFeedingEnv {
         };
         let props = self.models[kind.index()].sample(&mut self.rng);
         let setting = self.settings[self.rng.random_range(0..self.settings.len())];
-        let item = Item {
-            index: self.cursor,
-            label: kind.name().to_string(),
-            description: Some(format!("{} {}", kind.description(), setting.description())),
-        };
+        let item = Item::new(self.cursor, kind.name().to_string()).with_description(format!(
+            "{} {}",
+            kind.description(),
+            setting.description()
+        ));
         self.cursor += 1;
         self.current = Some(Current {
             item: item.clone(),

@@ -141,18 +141,16 @@ fn a_short_episode_runs_through_the_session_loop() {
     // Ask about the first item, then act on its own with TA0.
     let mut policy = ScriptedPolicy::new(6, 16, vec![query, Choice::Act { arm: ArmId(4) }]);
     let mut channel = PerfectExpert::default();
-    let mut session = Session {
-        settings: SessionSettings {
-            n_att: 2,
-            wl0: 0.5,
-            max_items: Some(2),
-        },
-        environment: &mut env,
-        policy: &mut policy,
-        channel: &mut channel,
-        workload: Arc::new(CountingWorkload::new(0.1)),
-        forecast: None,
-    };
+    let mut session = Session::new(
+        SessionSettings::default()
+            .with_n_att(2)
+            .with_wl0(0.5)
+            .with_max_items(Some(2)),
+        &mut env,
+        &mut policy,
+        &mut channel,
+        Arc::new(CountingWorkload::new(0.1)),
+    );
     let report = session.run_episode(3, &mut []).unwrap();
     assert_eq!(report.metrics.n_items, 2);
     assert_eq!(report.metrics.n_q, 1);

@@ -111,17 +111,12 @@ impl<R: QueryRule> Policy for LinearPolicy<R> {
         let alpha = self.rule.alpha();
         // The estimator validates the context (dimension, finiteness).
         let scores = self.arms.scores(input.context)?;
-        let mut diag = Diagnostics {
-            arms: scores
+        let mut diag = Diagnostics::new().with_arms(
+            scores
                 .iter()
-                .map(|e| ArmDiagnostics {
-                    estimate: e.estimate,
-                    bonus: e.bonus,
-                    ucb: e.ucb(alpha),
-                })
+                .map(|e| ArmDiagnostics::new(e.estimate, e.bonus, e.ucb(alpha)))
                 .collect(),
-            ..Default::default()
-        };
+        );
         let ucb_arm = ArmId(common::argmax(&scores, |s| s.ucb(alpha)));
         let ctx = RuleContext {
             scores: &scores,

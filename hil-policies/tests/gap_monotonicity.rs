@@ -64,14 +64,7 @@ impl WorkloadModel for Fixed {
 fn queries(p: &mut LinUcbQg, x: &Context, wl: f64) -> bool {
     let model = Fixed(wl);
     let h = QueryHistory::new();
-    let input = DecisionInput {
-        context: x,
-        t: 1,
-        item_index: 0,
-        items_seen: 0,
-        attempt: 0,
-        workload: WorkloadForecast::new(Some(&model), 0.5, &h, 1),
-    };
+    let input = DecisionInput::new(x, 1, WorkloadForecast::new(Some(&model), 0.5, &h, 1));
     matches!(p.decide(&input).unwrap().choice, Choice::Query { .. })
 }
 

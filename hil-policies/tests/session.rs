@@ -26,18 +26,16 @@ fn env() -> TableEnv {
 fn run(policy: &mut dyn Policy, seed: u64) -> EpisodeReport {
     let mut env = env();
     let mut channel = PerfectExpert::default();
-    let mut s = Session {
-        settings: SessionSettings {
-            n_att: 4,
-            wl0: 0.5,
-            max_items: None,
-        },
-        environment: &mut env,
+    let mut s = Session::new(
+        SessionSettings::default()
+            .with_n_att(4)
+            .with_wl0(0.5)
+            .with_max_items(None),
+        &mut env,
         policy,
-        channel: &mut channel,
-        workload: Arc::new(CountingWorkload::new(0.05)),
-        forecast: None,
-    };
+        &mut channel,
+        Arc::new(CountingWorkload::new(0.05)),
+    );
     s.run_episode(seed, &mut []).unwrap()
 }
 

@@ -15,14 +15,7 @@ use hil_core::{
 };
 
 fn input_for<'a>(x: &'a Context, h: &'a QueryHistory) -> DecisionInput<'a> {
-    DecisionInput {
-        context: x,
-        t: 1,
-        item_index: 0,
-        items_seen: 0,
-        attempt: 1,
-        workload: WorkloadForecast::none(h),
-    }
+    DecisionInput::new(x, 1, WorkloadForecast::none(h)).at_item(0, 0, 1)
 }
 
 fn bench(c: &mut Criterion) {

@@ -60,25 +60,12 @@ fn x() -> Context {
 fn decide(p: &mut dyn Policy) -> hil_core::Result<hil_core::Decision> {
     let h = QueryHistory::new();
     let x = x();
-    p.decide(&DecisionInput {
-        context: &x,
-        t: 1,
-        item_index: 0,
-        items_seen: 0,
-        attempt: 0,
-        workload: WorkloadForecast::none(&h),
-    })
+    p.decide(&DecisionInput::new(&x, 1, WorkloadForecast::none(&h)))
 }
 
 fn observe(p: &mut dyn Policy) -> hil_core::Result<()> {
     let x = x();
-    p.observe(&Feedback {
-        context: &x,
-        arm: ArmId(0),
-        reward: 1.0,
-        t: 1,
-        from_expert: false,
-    })
+    p.observe(&Feedback::new(&x, ArmId(0), 1.0, 1))
 }
 
 #[test]
@@ -181,18 +168,14 @@ fn query_channel_panics_are_errors() {
     let build = |m: &str| plugin::build_query_channel("panicky_channel", &params(m), &ctx());
     assert_panicked(build("factory"), "factory");
     assert_panicked(build("name"), "name");
-    let q = Query {
-        t: 1,
-        item: Item {
-            index: 0,
-            label: "thing".into(),
-            description: None,
-        },
-        kind: QueryKind::default(),
-        actions: ActionSpace::new(["a", "b"]).unwrap(),
-        context: x(),
-        oracle_best: Some(ArmId(1)),
-    };
+    let q = Query::new(
+        1,
+        Item::new(0, "thing"),
+        QueryKind::default(),
+        ActionSpace::new(["a", "b"]).unwrap(),
+        x(),
+    )
+    .with_oracle_best(ArmId(1));
     let mut c = build("ask").unwrap();
     assert_panicked(c.ask(&q), "ask");
     assert_poisoned(c.ask(&q), "ask");

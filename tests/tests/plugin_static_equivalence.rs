@@ -41,14 +41,13 @@ fn episodes(policy: &mut dyn Policy, n: usize) -> Vec<EpisodeReport> {
     let workload = Arc::new(CountingWorkload::new(0.05));
     (0..n as u64)
         .map(|k| {
-            let mut s = Session {
-                settings: SessionSettings::default(),
-                environment: &mut env,
-                policy: &mut *policy,
-                channel: &mut channel,
-                workload: workload.clone(),
-                forecast: None,
-            };
+            let mut s = Session::new(
+                SessionSettings::default(),
+                &mut env,
+                &mut *policy,
+                &mut channel,
+                workload.clone(),
+            );
             s.run_episode(100 + k, &mut []).unwrap()
         })
         .collect()

@@ -147,11 +147,7 @@ impl Environment for CupHandover {
             self.rng.random::<f64>(),
             f64::from(self.rng.random_bool(0.8)),
         ];
-        let item = Item {
-            index: self.next,
-            label: "cup".into(),
-            description: Some("a cup of water to hand over".into()),
-        };
+        let item = Item::new(self.next, "cup").with_description("a cup of water to hand over");
         self.next += 1;
         self.current = Some((item.clone(), posture, Self::probabilities(&posture)));
         self.calls.on_next_item(true);
@@ -177,10 +173,7 @@ impl Environment for CupHandover {
             .as_ref()
             .ok_or_else(|| HilError::state("cup_handover", "no current handover"))?
             .2[arm.0];
-        Ok(Outcome {
-            success: self.rng.random_bool(p),
-            success_probability: Some(p),
-        })
+        Ok(Outcome::new(self.rng.random_bool(p)).with_success_probability(p))
     }
     fn best_action(&self) -> Option<ArmId> {
         let p = self.current.as_ref()?.2;
@@ -222,14 +215,13 @@ mod tests {
             }],
         );
         let mut channel = PerfectExpert::default();
-        let mut session = Session {
-            settings: SessionSettings::default(),
-            environment: &mut env,
-            policy: &mut policy,
-            channel: &mut channel,
-            workload: Arc::new(CountingWorkload::new(0.01)),
-            forecast: None,
-        };
+        let mut session = Session::new(
+            SessionSettings::default(),
+            &mut env,
+            &mut policy,
+            &mut channel,
+            Arc::new(CountingWorkload::new(0.01)),
+        );
         let report = session.run_episode(3, &mut []).unwrap();
         assert_eq!(report.metrics.n_items, 5);
         // Always asking a perfect expert: every handover uses the best pose.

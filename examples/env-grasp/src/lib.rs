@@ -207,14 +207,10 @@ impl Environment for GraspEnv {
             return Ok(None);
         }
         let obj = self.pool[self.rng.random_range(0..self.pool.len())];
-        let item = Item {
-            index: self.next,
-            label: OBJECTS[obj].0.to_string(),
-            description: Some(format!(
-                "a {} on the table",
-                OBJECTS[obj].0.replace('_', " ")
-            )),
-        };
+        let item = Item::new(self.next, OBJECTS[obj].0.to_string()).with_description(format!(
+            "a {} on the table",
+            OBJECTS[obj].0.replace('_', " ")
+        ));
         self.next += 1;
         self.current = Some((item.clone(), obj));
         self.calls.on_next_item(true);
@@ -239,10 +235,7 @@ impl Environment for GraspEnv {
         self.calls.on_execute()?;
         let obj = self.object()?;
         let p = OBJECTS[obj].2[arm.0];
-        Ok(Outcome {
-            success: self.rng.random_bool(p),
-            success_probability: Some(p),
-        })
+        Ok(Outcome::new(self.rng.random_bool(p)).with_success_probability(p))
     }
     fn best_action(&self) -> Option<ArmId> {
         let obj = self.object().ok()?;

@@ -243,19 +243,19 @@ impl Policy for LinearThompson {
             wins += usize::from(best.1 == chosen);
         }
         let agreement = wins as f64 / self.params.samples as f64;
-        let diagnostics = |forecast: Option<f64>| Diagnostics {
-            arms: scores
-                .iter()
-                .map(|&(m, w)| ArmDiagnostics {
-                    estimate: m,
-                    bonus: w,
-                    ucb: m + v * w,
-                })
-                .collect(),
-            gap: Some(agreement),
-            threshold: Some(self.params.confidence),
-            workload_forecast: forecast,
-            ..Default::default()
+        // The agreement between posterior draws is this policy's own
+        // quantity, not LinUCB-QG's gap: it goes in the extension map.
+        let diagnostics = |forecast: Option<f64>| {
+            Diagnostics::new()
+                .with_arms(
+                    scores
+                        .iter()
+                        .map(|&(m, w)| ArmDiagnostics::new(m, w, m + v * w))
+                        .collect(),
+                )
+                .with_extra("agreement", agreement)
+                .with_extra("confidence", self.params.confidence)
+                .with_workload_forecast(forecast)
         };
         let arm = ArmId(chosen);
         if agreement < self.params.confidence {
@@ -370,23 +370,15 @@ mod tests {
         let x = hil_core::Context::new(vec![1.0]).unwrap();
         let history = hil_core::QueryHistory::new();
         for t in 1..=200 {
-            let fb = Feedback {
-                context: &x,
-                arm: ArmId((t % 2) as usize),
-                reward: if t % 2 == 1 { 1.0 } else { 0.0 },
+            let fb = Feedback::new(
+                &x,
+                ArmId((t % 2) as usize),
+                if t % 2 == 1 { 1.0 } else { 0.0 },
                 t,
-                from_expert: false,
-            };
+            );
             p.observe(&fb).unwrap();
         }
-        let input = DecisionInput {
-            context: &x,
-            t: 201,
-            item_index: 0,
-            items_seen: 0,
-            attempt: 0,
-            workload: hil_core::WorkloadForecast::none(&history),
-        };
+        let input = DecisionInput::new(&x, 201, hil_core::WorkloadForecast::none(&history));
         let d = p.decide(&input).unwrap();
         assert_eq!(d.choice, hil_core::Choice::Act { arm: ArmId(1) });
     }

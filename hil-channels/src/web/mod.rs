@@ -322,21 +322,14 @@ impl QueryChannel for WebChannel {
                     ),
                     None => "Thank you. The robot will choose on its own.".to_string(),
                 });
-                return Ok(Response {
-                    answer,
-                    expert_arm,
-                    response_time_s: Some(elapsed),
-                });
+                return Ok(Response::new(answer, expert_arm, Some(elapsed)));
             }
             let now = Instant::now();
             if now >= deadline {
                 state.current = None;
                 state.notice = Some("No answer in time: the robot chose on its own.".to_string());
-                return Ok(Response {
-                    answer: Answer::TimedOut,
-                    expert_arm: None,
-                    response_time_s: Some(self.shared.timeout.as_secs_f64()),
-                });
+                return Ok(Response::without_action(Answer::TimedOut)
+                    .with_response_time(self.shared.timeout.as_secs_f64()));
             }
             state = self
                 .shared

@@ -75,21 +75,17 @@ pub fn same_origin(addr: SocketAddr) -> String {
 
 /// A question about a cantaloupe cube with the feeding actions.
 pub fn query(t: u64, response: ResponseType) -> Query {
-    Query {
+    Query::new(
         t,
-        item: Item {
-            index: 0,
-            label: "cantaloupe".into(),
-            description: Some("a cube of cantaloupe".into()),
-        },
-        kind: QueryKind {
+        Item::new(0, "cantaloupe").with_description("a cube of cantaloupe"),
+        QueryKind {
             response,
             ..Default::default()
         },
-        actions: hil_envs::feeding::action_space(),
-        context: Context::new(vec![0.1]).unwrap(),
-        oracle_best: Some(ArmId(1)),
-    }
+        hil_envs::feeding::action_space(),
+        Context::new(vec![0.1]).unwrap(),
+    )
+    .with_oracle_best(ArmId(1))
 }
 
 /// Asks `q` on a thread; the handle returns the channel and the response.

@@ -249,14 +249,9 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         }
         let x = rng.context(a.dim);
         let t = s as Timestep + 1;
-        let input = DecisionInput {
-            context: &x,
-            t,
-            item_index: s,
-            items_seen: s,
-            attempt: 0,
-            workload: WorkloadForecast::new(Some(&model), 0.5, &history, t),
-        };
+        let input =
+            DecisionInput::new(&x, t, WorkloadForecast::new(Some(&model), 0.5, &history, t))
+                .at_item(s, s, 0);
         let start = Instant::now();
         let d = policy.decide(&input)?;
         let mid = Instant::now();
@@ -272,13 +267,7 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         };
         let reward = f64::from(rng.unit() < p_success(&x, arm.0));
         let mid2 = Instant::now();
-        policy.observe(&Feedback {
-            context: &x,
-            arm,
-            reward,
-            t,
-            from_expert: expert,
-        })?;
+        policy.observe(&Feedback::new(&x, arm, reward, t).from_expert(expert))?;
         let end = Instant::now();
         if let Choice::Query { kind, .. } = d.choice {
             history.push(t, kind)?;

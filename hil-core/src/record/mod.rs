@@ -121,7 +121,7 @@ impl LoggedSession {
                             e,
                             StepEvent {
                                 step,
-                                outcome: *outcome,
+                                outcome: outcome.clone(),
                             },
                         ));
                     }

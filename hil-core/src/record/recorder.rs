@@ -127,7 +127,7 @@ impl SessionObserver for Recorder {
         self.emit(&Record::Outcome {
             episode: self.episode,
             t: event.step.t,
-            outcome: event.outcome,
+            outcome: event.outcome.clone(),
         })
     }
 

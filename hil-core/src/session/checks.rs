@@ -41,6 +41,9 @@ pub(crate) fn diagnostics(policy: &str, d: &Diagnostics) -> Result<()> {
             return bad(name.to_string(), v);
         }
     }
+    if let Some((name, v)) = d.extra.iter().find(|(_, v)| !v.is_finite()) {
+        return bad(format!("extra.{name}"), v);
+    }
     Ok(())
 }
 

@@ -48,6 +48,7 @@ pub const DEFAULT_N_ATT: u32 = 10;
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
+#[non_exhaustive]
 pub struct SessionSettings {
     /// Maximum attempts per item (N_att).
     pub n_att: u32,
@@ -68,6 +69,24 @@ impl Default for SessionSettings {
 }
 
 impl SessionSettings {
+    /// The defaults with at most `n_att` attempts per item.
+    pub fn with_n_att(mut self, n_att: u32) -> Self {
+        self.n_att = n_att;
+        self
+    }
+
+    /// With initial workload `wl0`.
+    pub fn with_wl0(mut self, wl0: f64) -> Self {
+        self.wl0 = wl0;
+        self
+    }
+
+    /// Stopping after `max_items` items (or when the environment runs out).
+    pub fn with_max_items(mut self, max_items: Option<usize>) -> Self {
+        self.max_items = max_items;
+        self
+    }
+
     /// Checks every field.
     pub fn validate(&self) -> Result<()> {
         if self.n_att == 0 {
@@ -130,6 +149,30 @@ pub struct EpisodeReport {
 
 /// The components of a session, borrowed so that the caller keeps them
 /// (a policy carries its learning on to the next episode).
+///
+/// ```
+/// use std::sync::Arc;
+/// use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
+/// use hil_core::{ActionSpace, ArmId, Choice, Environment, PerfectExpert, Session, SessionSettings};
+///
+/// let actions = ActionSpace::new(["left", "right"]).unwrap();
+/// let items = vec![("apple", vec![0.9, 0.1]), ("pear", vec![0.2, 0.8])];
+/// let mut env = TableEnv::new(actions, items).unwrap();
+/// let dim = env.context_dim();
+/// let mut policy = ScriptedPolicy::new(2, dim, vec![Choice::Act { arm: ArmId(0) }]);
+/// let mut expert = PerfectExpert::default();
+/// let mut session = Session::new(
+///     SessionSettings::default().with_n_att(2),
+///     &mut env,
+///     &mut policy,
+///     &mut expert,
+///     Arc::new(CountingWorkload::new(0.1)),
+/// );
+/// let report = session.run_episode(7, &mut []).unwrap();
+/// assert_eq!(report.metrics.n_items, 2);
+/// assert_eq!(report.metrics.n_q, 0); // this script never asks
+/// ```
+#[non_exhaustive]
 pub struct Session<'a> {
     /// Loop settings.
     pub settings: SessionSettings,
@@ -145,6 +188,34 @@ pub struct Session<'a> {
     /// The workload model the policy forecasts with; `None` means the same as
     /// `workload`. They differ in the paper's cross-data experiment.
     pub forecast: Option<Arc<dyn WorkloadModel>>,
+}
+
+impl<'a> Session<'a> {
+    /// A session of `policy` in `environment`, asking through `channel`,
+    /// whose workload evolves (and is forecast) by `workload`.
+    pub fn new(
+        settings: SessionSettings,
+        environment: &'a mut dyn Environment,
+        policy: &'a mut dyn Policy,
+        channel: &'a mut dyn QueryChannel,
+        workload: Arc<dyn WorkloadModel>,
+    ) -> Self {
+        Self {
+            settings,
+            environment,
+            policy,
+            channel,
+            workload,
+            forecast: None,
+        }
+    }
+
+    /// With a different model for the policy's forecasts (the paper's
+    /// cross-data experiment); `None` forecasts with the session's model.
+    pub fn with_forecast(mut self, forecast: Option<Arc<dyn WorkloadModel>>) -> Self {
+        self.forecast = forecast;
+        self
+    }
 }
 
 impl std::fmt::Debug for Session<'_> {

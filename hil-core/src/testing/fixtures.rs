@@ -135,10 +135,7 @@ impl Environment for TableEnv {
             None => self.rng.random_bool(p),
         };
         self.played += 1;
-        Ok(Outcome {
-            success,
-            success_probability: Some(p),
-        })
+        Ok(Outcome::new(success).with_success_probability(p))
     }
     fn best_action(&self) -> Option<ArmId> {
         let p = self.probs().ok()?;

@@ -96,11 +96,10 @@ fn paper_repetitions() -> usize {
     2
 }
 fn paper_session() -> SessionSettings {
-    SessionSettings {
-        n_att: PAPER_N_ATT,
-        wl0: PAPER_WL0,
-        max_items: None,
-    }
+    SessionSettings::default()
+        .with_n_att(PAPER_N_ATT)
+        .with_wl0(PAPER_WL0)
+        .with_max_items(None)
 }
 fn paper_environment() -> Box<dyn EnvironmentConfig> {
     Box::new(hil_kinova_mujoco::KinovaFeedingConfig {

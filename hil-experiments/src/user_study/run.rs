@@ -305,14 +305,13 @@ impl UserStudy<'_> {
             let mut episode =
                 |env: &mut dyn Environment, observers: &mut [&mut dyn SessionObserver]| {
                     env_name = env.name().to_string();
-                    Session {
-                        settings: cfg.session.clone(),
-                        environment: env,
-                        policy: &mut *policy,
-                        channel: channel.as_mut(),
-                        workload: Arc::clone(&workload),
-                        forecast: None,
-                    }
+                    Session::new(
+                        cfg.session.clone(),
+                        env,
+                        &mut *policy,
+                        channel.as_mut(),
+                        Arc::clone(&workload),
+                    )
                     .run_episode(plate.seed, observers)
                 };
             let report = each(&plate, env, &mut episode)?;

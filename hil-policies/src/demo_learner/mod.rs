@@ -167,22 +167,18 @@ impl Policy for DemoLearner {
         let random_arm = self.rng.random_range(0..self.n_arms);
         let ask = self.rng.random_bool(self.params.query_probability);
         let arm = ArmId(if explore { random_arm } else { greedy });
-        let diagnostics = Diagnostics {
-            arms: estimates
-                .iter()
-                .map(|e| ArmDiagnostics {
-                    estimate: *e,
-                    bonus: 0.0,
-                    ucb: *e,
-                })
-                .collect(),
-            query_probability: Some(if input.attempt == 0 {
+        let diagnostics = Diagnostics::new()
+            .with_arms(
+                estimates
+                    .iter()
+                    .map(|e| ArmDiagnostics::new(*e, 0.0, *e))
+                    .collect(),
+            )
+            .with_query_probability(if input.attempt == 0 {
                 self.params.query_probability
             } else {
                 0.0
-            }),
-            ..Default::default()
-        };
+            });
         let decision = if input.attempt == 0 && ask {
             let kind = if self.params.kinds.is_empty() {
                 QueryKind::default()

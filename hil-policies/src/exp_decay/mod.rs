@@ -146,14 +146,9 @@ mod tests {
             let h = QueryHistory::new();
             let probs: Vec<f64> = (0..5)
                 .map(|items_seen| {
-                    let input = DecisionInput {
-                        context: &x,
-                        t: 1 + items_seen as u64,
-                        item_index: items_seen,
-                        items_seen,
-                        attempt: 0,
-                        workload: WorkloadForecast::none(&h),
-                    };
+                    let input =
+                        DecisionInput::new(&x, 1 + items_seen as u64, WorkloadForecast::none(&h))
+                            .at_item(items_seen, items_seen, 0);
                     p.decide(&input)
                         .unwrap()
                         .diagnostics

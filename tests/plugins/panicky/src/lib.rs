@@ -104,11 +104,7 @@ impl Environment for Panicky {
     }
     fn next_item(&mut self) -> Result<Option<Item>> {
         self.maybe("next_item");
-        self.item = Some(Item {
-            index: 0,
-            label: "thing".into(),
-            description: None,
-        });
+        self.item = Some(Item::new(0, "thing"));
         Ok(self.item.clone())
     }
     fn observe(&mut self) -> Result<Context> {
@@ -117,10 +113,7 @@ impl Environment for Panicky {
     }
     fn execute(&mut self, _arm: ArmId) -> Result<Outcome> {
         self.maybe("execute");
-        Ok(Outcome {
-            success: true,
-            success_probability: None,
-        })
+        Ok(Outcome::new(true))
     }
     fn best_action(&self) -> Option<ArmId> {
         self.maybe("best_action");

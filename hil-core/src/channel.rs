@@ -47,14 +47,9 @@ pub trait QueryChannel: Send {
 /// use hil_core::{ActionSpace, ArmId, Context, HilError, Item, Query, QueryChannel};
 ///
 /// let mut expert = PerfectExpert::default();
-/// let mut query = Query {
-///     t: 1,
-///     item: Item { index: 0, label: "cup".into(), description: None },
-///     kind: Default::default(),
-///     actions: ActionSpace::new(["left", "right"])?,
-///     context: Context::new(vec![1.0])?,
-///     oracle_best: Some(ArmId(1)),
-/// };
+/// let actions = ActionSpace::new(["left", "right"])?;
+/// let mut query = Query::new(1, Item::new(0, "cup"), Default::default(), actions, Context::new(vec![1.0])?)
+///     .with_oracle_best(ArmId(1));
 /// assert_eq!(expert.ask(&query)?.expert_arm, Some(ArmId(1)));
 /// assert_eq!(expert.asked, 1);
 /// query.oracle_best = None;

@@ -7,12 +7,12 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, LogNormal};
 use serde::{Deserialize, Serialize};
 
+use hil_core::TaskContext;
 use hil_core::channel::PerfectExpert;
 use hil_core::config::{QueryChannelConfig, limits};
 use hil_core::session::splitmix;
 use hil_core::{
-    Answer, ArmId, BoundingBox, BuildContext, HilError, Query, QueryChannel, Response,
-    ResponseType, Result,
+    Answer, ArmId, BoundingBox, HilError, Query, QueryChannel, Response, ResponseType, Result,
 };
 
 /// Largest log-space spread of simulated response times: with it, a draw
@@ -108,7 +108,7 @@ impl SimulatedExpertConfig {
 
 #[typetag::serde(name = "simulated_expert")]
 impl QueryChannelConfig for SimulatedExpertConfig {
-    fn build(&self, _ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
+    fn build(&self, _ctx: &TaskContext) -> Result<Box<dyn QueryChannel>> {
         Ok(Box::new(SimulatedExpert::new(self.clone())?))
     }
 

@@ -7,13 +7,13 @@ use serde::{Deserialize, Serialize};
 
 use hil_core::config::QueryChannelConfig;
 use hil_core::{
-    Answer, BoundingBox, BuildContext, HilError, Query, QueryChannel, Response, ResponseType,
-    Result,
+    Answer, BoundingBox, HilError, Query, QueryChannel, Response, ResponseType, Result,
 };
 
 use crate::present::{
     check_bbox, check_text, describe_item, describe_kind, question, validate_answer,
 };
+use hil_core::TaskContext;
 
 /// Config of the terminal channel, `type = "terminal"` (no parameters): the
 /// prompt is written to standard error and answers are read from standard
@@ -24,7 +24,7 @@ pub struct TerminalChannelConfig {}
 
 #[typetag::serde(name = "terminal")]
 impl QueryChannelConfig for TerminalChannelConfig {
-    fn build(&self, _ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
+    fn build(&self, _ctx: &TaskContext) -> Result<Box<dyn QueryChannel>> {
         Ok(Box::new(TerminalChannel::stdio()))
     }
 }

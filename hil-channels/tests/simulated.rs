@@ -1,6 +1,8 @@
 //! Simulated experts: conformance, rates, seeding and configs.
 
 use hil_channels::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
+use hil_core::ActionSpace;
+use hil_core::TaskContext;
 use hil_core::channel::PerfectExpert;
 use hil_core::config::QueryChannelConfig;
 use hil_core::testing::check_query_channel;
@@ -163,7 +165,8 @@ struct Doc {
 
 #[test]
 fn config_parses_validates_and_rejects_unknown_fields() {
-    let ctx = BuildContext::new(".", 0);
+    let actions = ActionSpace::new(["a", "b"]).unwrap();
+    let ctx = TaskContext::new(BuildContext::new(".", 0), actions, 3);
     let ok: Doc = toml::from_str(
         "[channel]\ntype = \"simulated_expert\"\nerror_rate = 0.1\ndecline_rate = 0.05\nresponse_time = { median_s = 3.0, sigma = 0.2 }\n",
     )

@@ -48,24 +48,86 @@ use crate::policy::Policy;
 use crate::session::SessionSettings;
 use crate::workload::WorkloadModel;
 
-/// What a component factory may need to know about the experiment.
+/// What every component factory may need: where relative paths resolve,
+/// the experiment seed and the build-wide memo. Environments and workload
+/// models are built from this alone; policies and query channels from a
+/// [`TaskContext`], which adds the built environment's facts.
 #[derive(Clone, Debug)]
 pub struct BuildContext {
     /// Directory relative paths in the config are resolved against.
     pub base_dir: PathBuf,
     /// The experiment seed.
     pub seed: u64,
-    /// The environment's action space (known once the environment is built).
-    pub action_space: Option<ActionSpace>,
-    /// The environment's context dimension (known once it is built).
-    pub context_dim: Option<usize>,
-    /// Offline (context, arm, reward) data the environment offers for
-    /// pretraining (see [`EnvironmentConfig::pretraining`]).
-    pub pretraining: Option<Arc<[LabelledObservation]>>,
     /// Work shared by every component built from this context (and its
     /// clones): a protocol that builds hundreds of policies from one context
     /// pretrains each distinct estimator once.
     pub memo: Arc<BuildMemo>,
+}
+
+/// What policy and query-channel factories are built from: the
+/// [`BuildContext`] plus the facts of the environment they will act in.
+/// Every fact is known, so a factory never has to check for a missing one;
+/// [`BuildContext::describe_environment`] makes it from a built environment.
+///
+/// ```
+/// use hil_core::{ActionSpace, BuildContext, TaskContext};
+/// let actions = ActionSpace::new(["left", "right"]).unwrap();
+/// let ctx = TaskContext::new(BuildContext::new(".", 7), actions, 4);
+/// assert_eq!((ctx.action_space().len(), ctx.context_dim(), ctx.base().seed), (2, 4, 7));
+/// assert!(ctx.pretraining().is_none());
+/// ```
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub struct TaskContext {
+    base: BuildContext,
+    action_space: ActionSpace,
+    context_dim: usize,
+    pretraining: Option<Arc<[LabelledObservation]>>,
+}
+
+impl TaskContext {
+    /// The context for components acting among `action_space` on contexts of
+    /// dimension `context_dim`, with no pretraining data.
+    pub fn new(base: BuildContext, action_space: ActionSpace, context_dim: usize) -> Self {
+        Self {
+            base,
+            action_space,
+            context_dim,
+            pretraining: None,
+        }
+    }
+
+    /// With offline (context, arm, reward) data for pretraining policies.
+    pub fn with_pretraining(mut self, data: Arc<[LabelledObservation]>) -> Self {
+        self.pretraining = Some(data);
+        self
+    }
+
+    /// Paths, seed and memo.
+    pub fn base(&self) -> &BuildContext {
+        &self.base
+    }
+
+    /// The environment's action space.
+    pub fn action_space(&self) -> &ActionSpace {
+        &self.action_space
+    }
+
+    /// The environment's context dimension.
+    pub fn context_dim(&self) -> usize {
+        self.context_dim
+    }
+
+    /// The offline data the environment offers for pretraining (see
+    /// [`EnvironmentConfig::pretraining`]), if any.
+    pub fn pretraining(&self) -> Option<&Arc<[LabelledObservation]>> {
+        self.pretraining.as_ref()
+    }
+
+    /// Resolves `path` against the config's directory unless it is absolute.
+    pub fn resolve(&self, path: &Path) -> PathBuf {
+        self.base.resolve(path)
+    }
 }
 
 /// A cache of values derived from a [`BuildContext`] (e.g. an estimator
@@ -121,27 +183,29 @@ impl BuildContext {
         Self {
             base_dir: base_dir.into(),
             seed,
-            action_space: None,
-            context_dim: None,
-            pretraining: None,
             memo: Arc::default(),
         }
     }
 
-    /// Records what policy and channel factories need to know about a built
-    /// environment: its action space, its context dimension and the
-    /// pretraining data its `config` offers. Every protocol that builds an
-    /// environment and then the components around it calls this between the
-    /// two, so they all see the same facts.
+    /// The context for the policy and channel of a built environment: its
+    /// action space, its context dimension and the pretraining data its
+    /// `config` offers. Every protocol that builds an environment and then
+    /// the components around it goes through this, so they all see the same
+    /// facts.
     pub fn describe_environment(
-        &mut self,
+        &self,
         config: &dyn EnvironmentConfig,
         environment: &dyn Environment,
-    ) -> Result<()> {
-        self.action_space = Some(environment.action_space().clone());
-        self.context_dim = Some(environment.context_dim());
-        self.pretraining = config.pretraining(self)?;
-        Ok(())
+    ) -> Result<TaskContext> {
+        let task = TaskContext::new(
+            self.clone(),
+            environment.action_space().clone(),
+            environment.context_dim(),
+        );
+        Ok(match config.pretraining(self)? {
+            Some(data) => task.with_pretraining(data),
+            None => task,
+        })
     }
 
     /// Resolves `path` against the config's directory unless it is absolute.
@@ -159,7 +223,7 @@ impl BuildContext {
 pub trait PolicyConfig: std::fmt::Debug + Send + Sync {
     /// Validates the parameters and builds the policy for the environment
     /// described by `ctx`.
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>>;
+    fn build(&self, ctx: &TaskContext) -> Result<Box<dyn Policy>>;
 
     /// Checks the parameters that need no environment. A config loader
     /// ([`ExperimentConfig::parse`]) calls it on every component it reads
@@ -201,7 +265,7 @@ pub trait EnvironmentConfig: std::fmt::Debug + Send + Sync {
 
     /// Offline data for pretraining policies (e.g. the pretraining foods of
     /// a dataset), handed to policy configs through
-    /// [`BuildContext::pretraining`]. None by default.
+    /// [`TaskContext::pretraining`]. None by default.
     fn pretraining(&self, ctx: &BuildContext) -> Result<Option<Arc<[LabelledObservation]>>> {
         let _ = ctx;
         Ok(None)
@@ -224,7 +288,7 @@ pub trait WorkloadModelConfig: std::fmt::Debug + Send + Sync {
 #[typetag::serde(tag = "type")]
 pub trait QueryChannelConfig: std::fmt::Debug + Send + Sync {
     /// Validates the parameters and builds the channel.
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn QueryChannel>>;
+    fn build(&self, ctx: &TaskContext) -> Result<Box<dyn QueryChannel>>;
 
     /// Checks the parameters at load time; see [`PolicyConfig::validate`].
     fn validate(&self) -> Result<()> {

@@ -80,16 +80,16 @@ impl ExperimentConfig {
     /// The environment is built first, so that the policy and the channel
     /// know its action space and context dimension.
     pub fn build(&self, base_dir: &Path) -> Result<Experiment> {
-        let mut ctx = BuildContext::new(base_dir, self.seed);
+        let ctx = BuildContext::new(base_dir, self.seed);
         let environment = self.environment.build(&ctx)?;
-        ctx.describe_environment(self.environment.as_ref(), environment.as_ref())?;
-        let policy = self.policy.build(&ctx)?;
+        let task = ctx.describe_environment(self.environment.as_ref(), environment.as_ref())?;
+        let policy = self.policy.build(&task)?;
         let workload = self.workload.build(&ctx)?;
         let forecast = match &self.policy_workload {
             Some(c) => Some(c.build(&ctx)?),
             None => None,
         };
-        let channel = self.channel.build(&ctx)?;
+        let channel = self.channel.build(&task)?;
         Ok(Experiment {
             settings: self.session.clone(),
             seed: self.seed,

@@ -47,7 +47,7 @@ pub mod testing;
 
 pub use action::{ActionSpace, ArmId};
 pub use channel::{PerfectExpert, QueryChannel};
-pub use config::{BuildContext, BuildMemo, ConfigError, ExperimentConfig};
+pub use config::{BuildContext, BuildMemo, ConfigError, ExperimentConfig, TaskContext};
 pub use context::Context;
 pub use decision::{
     ArmDiagnostics, Choice, Decision, Diagnostics, Extras, LabelledObservation, Outcome,

@@ -4,6 +4,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
+use hil_core::TaskContext;
 use hil_core::channel::PerfectExpert;
 use hil_core::config::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
 use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
@@ -43,8 +44,8 @@ struct AskFirstConfig {
 
 #[typetag::serde(name = "test_ask_first")]
 impl PolicyConfig for AskFirstConfig {
-    fn build(&self, ctx: &BuildContext) -> hil_core::Result<Box<dyn Policy>> {
-        let n = ctx.action_space.as_ref().map_or(0, ActionSpace::len);
+    fn build(&self, ctx: &TaskContext) -> hil_core::Result<Box<dyn Policy>> {
+        let n = ctx.action_space().len();
         if self.arm >= n {
             return Err(HilError::invalid_parameter(
                 "arm",
@@ -52,7 +53,7 @@ impl PolicyConfig for AskFirstConfig {
                 format!("must be below {n}"),
             ));
         }
-        let dim = ctx.context_dim.unwrap_or(0);
+        let dim = ctx.context_dim();
         Ok(Box::new(ScriptedPolicy::new(
             n,
             dim,
@@ -88,7 +89,7 @@ struct OracleConfig {}
 
 #[typetag::serde(name = "test_oracle")]
 impl QueryChannelConfig for OracleConfig {
-    fn build(&self, _ctx: &BuildContext) -> hil_core::Result<Box<dyn QueryChannel>> {
+    fn build(&self, _ctx: &TaskContext) -> hil_core::Result<Box<dyn QueryChannel>> {
         Ok(Box::new(PerfectExpert::default()))
     }
 }

@@ -35,7 +35,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use hil_core::config::BuildContext;
+use hil_core::config::{BuildContext, TaskContext};
 use hil_core::session::{ComponentSeeds, splitmix};
 use hil_core::{
     EpisodeMetrics, HilError, QueryChannel, Result, Session, SessionSettings, StepDecision,
@@ -621,19 +621,17 @@ impl Protocol {
 
     /// The build context of every policy: the dataset's actions and
     /// dimension, and the pretraining foods' data.
-    pub fn build_context(&self) -> Result<BuildContext> {
+    pub fn build_context(&self) -> Result<TaskContext> {
         let s = &self.settings;
-        let mut ctx = BuildContext::new(".", s.seed);
-        ctx.action_space = Some(self.dataset.actions.clone());
-        ctx.context_dim = Some(self.dataset.context_dim);
         let data = pretraining_data(
             &self.dataset,
             &s.split.pretrain,
             PretrainReward::Probability,
             s.seed,
         )?;
-        ctx.pretraining = Some(data.into());
-        Ok(ctx)
+        let base = BuildContext::new(".", s.seed);
+        let ctx = TaskContext::new(base, self.dataset.actions.clone(), self.dataset.context_dim);
+        Ok(ctx.with_pretraining(data.into()))
     }
 
     /// Every episode the protocol needs, each exactly once.
@@ -693,7 +691,7 @@ impl Protocol {
     }
 
     /// Runs one episode.
-    pub fn run_one(&self, key: &RunKey, ctx: &BuildContext) -> Result<RunRecord> {
+    pub fn run_one(&self, key: &RunKey, ctx: &TaskContext) -> Result<RunRecord> {
         let s = &self.settings;
         let foods = match key.phase {
             Phase::Validation => &s.split.validation,

@@ -23,7 +23,7 @@
 
 use std::fmt::Debug;
 
-use hil_core::{BuildContext, HilError, QueryKind, Result};
+use hil_core::{HilError, QueryKind, Result, TaskContext};
 use serde::de::{DeserializeOwned, Error as _};
 use serde::ser::Error as _;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -84,23 +84,12 @@ impl EstimatorConfig {
 
     /// Builds the estimator for the environment described by `ctx`,
     /// pretrained on its offline data if `pretrain` is set.
-    pub fn build_estimator(&self, ctx: &BuildContext) -> Result<LinearArms> {
-        let n_arms = ctx.action_space.as_ref().map(|a| a.len()).ok_or_else(|| {
-            HilError::state(
-                "policy config",
-                "the action space is unknown (build the environment first)",
-            )
-        })?;
-        let dim = ctx.context_dim.ok_or_else(|| {
-            HilError::state(
-                "policy config",
-                "the context dimension is unknown (build the environment first)",
-            )
-        })?;
+    pub fn build_estimator(&self, ctx: &TaskContext) -> Result<LinearArms> {
+        let (n_arms, dim) = (ctx.action_space().len(), ctx.context_dim());
         if !self.pretrain {
             return LinearArms::with_options(n_arms, dim, self.lambda, self.estimator);
         }
-        let data = ctx.pretraining.as_ref().ok_or_else(|| {
+        let data = ctx.pretraining().ok_or_else(|| {
             HilError::invalid_parameter(
                 "pretrain",
                 true,
@@ -114,7 +103,7 @@ impl EstimatorConfig {
             self.lambda.to_bits(),
             self.estimator
         );
-        ctx.memo.get_or_try_insert(&key, || {
+        ctx.base().memo.get_or_try_insert(&key, || {
             let mut arms = LinearArms::with_options(n_arms, dim, self.lambda, self.estimator)?;
             arms.pretrain(data)?;
             Ok(arms)
@@ -173,11 +162,11 @@ impl<F: RuleConfig> LinearPolicyConfig<F> {
 
     /// Validates the parameters and builds the policy, seeded with the
     /// config's seed if it has one, else the experiment seed.
-    pub fn build_policy(&self, ctx: &BuildContext) -> Result<LinearPolicy<F::Rule>> {
+    pub fn build_policy(&self, ctx: &TaskContext) -> Result<LinearPolicy<F::Rule>> {
         let params = self.rule.params(self.common.alpha, self.query_kind)?;
         let arms = self.common.build_estimator(ctx)?;
         let mut policy = LinearPolicy::new(params, arms);
-        hil_core::Policy::seed(&mut policy, self.rule.seed().unwrap_or(ctx.seed));
+        hil_core::Policy::seed(&mut policy, self.rule.seed().unwrap_or(ctx.base().seed));
         Ok(policy)
     }
 }
@@ -276,7 +265,7 @@ macro_rules! register {
         impl hil_core::config::PolicyConfig for $crate::config::LinearPolicyConfig<$fields> {
             fn build(
                 &self,
-                ctx: &hil_core::BuildContext,
+                ctx: &hil_core::TaskContext,
             ) -> hil_core::Result<Box<dyn hil_core::Policy>> {
                 Ok(Box::new(self.build_policy(ctx)?))
             }

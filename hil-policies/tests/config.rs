@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use hil_core::TaskContext;
 use hil_core::config::{ConfigError, PolicyConfig, parse_toml};
 use hil_core::{ActionSpace, BuildContext, HilError, QueryKind};
 use hil_policies::{LinUcbConfig, LinUcbExpDecayConfig, LinUcbQgConfig, POLICY_TYPES};
@@ -78,9 +79,11 @@ fn missing_and_mistyped_fields_are_named() {
 
 #[test]
 fn bad_values_are_invalid_parameters() {
-    let mut ctx = BuildContext::new(".", 0);
-    ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
-    ctx.context_dim = Some(3);
+    let ctx = TaskContext::new(
+        BuildContext::new(".", 0),
+        ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap(),
+        3,
+    );
     for (body, field) in [
         ("type = \"linucb_qg\"\nalpha = 0.5\nw = -1.0", "w"),
         ("type = \"linucb_exp_decay\"\nalpha = 0.5\nc = -1.0", "c"),

@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use hil_core::TaskContext;
 use hil_core::plugin::{self, Params};
 use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
 use hil_core::testing::fixtures::ScriptedPolicy;
@@ -41,9 +42,11 @@ fn bench(c: &mut Criterion) {
     )
     .unwrap();
     let h = QueryHistory::new();
-    let mut ctx = BuildContext::new(".", 3);
-    ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
-    ctx.context_dim = Some(dim);
+    let ctx = TaskContext::new(
+        BuildContext::new(".", 3),
+        ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap(),
+        dim,
+    );
 
     let mut g = c.benchmark_group("decide, trivial policy (d = 32)");
     let mut direct = ScriptedPolicy::new(6, dim, vec![Choice::Act { arm: ArmId(2) }]);

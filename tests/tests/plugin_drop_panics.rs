@@ -18,15 +18,17 @@ fn every_kind_of_object_reports_a_destructor_panic_to_the_host() {
     let lib = cdylib_path(&build_cdylibs(ws, &[krate]).unwrap(), krate);
     plugin::load(&lib).unwrap();
     let ctx = BuildContext::new(".", 0);
+    let actions = hil_core::ActionSpace::new(["a", "b"]).unwrap();
+    let task = hil_core::TaskContext::new(ctx.clone(), actions, 4);
     let p = Params::toml("panic_in = \"drop\"");
     assert!(plugin::take_destructor_panics().is_empty());
 
-    drop(plugin::build_policy("panicky_policy", &p, &ctx).unwrap());
+    drop(plugin::build_policy("panicky_policy", &p, &task).unwrap());
     drop(plugin::build_environment("panicky_env", &p, &ctx).unwrap());
     drop(plugin::build_workload_model("panicky_workload", &p, &ctx).unwrap());
-    drop(plugin::build_query_channel("panicky_channel", &p, &ctx).unwrap());
+    drop(plugin::build_query_channel("panicky_channel", &p, &task).unwrap());
     // An object that does not panic reports nothing.
-    drop(plugin::build_policy("panicky_policy", &Params::empty(), &ctx).unwrap());
+    drop(plugin::build_policy("panicky_policy", &Params::empty(), &task).unwrap());
 
     let reported = plugin::take_destructor_panics();
     let names: Vec<String> = reported

@@ -1,6 +1,7 @@
 //! Loading plugins: every refusal is a clear error naming the file, and
 //! loading is idempotent.
 
+use hil_core::TaskContext;
 mod common;
 
 use std::path::Path;
@@ -10,10 +11,13 @@ use hil_core::plugin::{self, ComponentKind, Params};
 use hil_core::{ActionSpace, BuildContext, HilError};
 
 fn ctx() -> BuildContext {
-    let mut ctx = BuildContext::new(".", 5);
-    ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
-    ctx.context_dim = Some(4);
-    ctx
+    BuildContext::new(".", 5)
+}
+
+/// What policies and channels are built from: six actions, 4-d contexts.
+fn task() -> TaskContext {
+    let actions = ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap();
+    TaskContext::new(ctx(), actions, 4)
 }
 
 fn why(e: &HilError) -> String {
@@ -127,7 +131,7 @@ fn a_duplicate_name_is_refused_naming_the_first_library() {
 #[test]
 fn an_unknown_name_lists_the_closest_registered_names() {
     plugin::load(&lib("hil-example-policy-thompson")).unwrap();
-    let e = plugin::build_policy("linear_thomson", &Params::empty(), &ctx())
+    let e = plugin::build_policy("linear_thomson", &Params::empty(), &task())
         .err()
         .unwrap();
     let msg = e.to_string();
@@ -138,7 +142,7 @@ fn an_unknown_name_lists_the_closest_registered_names() {
 #[test]
 fn a_factory_rejecting_its_parameters_says_which_and_why() {
     let info = plugin::load(&lib("hil-example-policy-thompson")).unwrap();
-    let e = plugin::build_policy("linear_thompson", &Params::toml("v = -1.0"), &ctx())
+    let e = plugin::build_policy("linear_thompson", &Params::toml("v = -1.0"), &task())
         .err()
         .unwrap();
     let msg = e.to_string();
@@ -148,9 +152,13 @@ fn a_factory_rejecting_its_parameters_says_which_and_why() {
         "{msg}"
     );
     assert!(msg.contains("`v` = -1"), "{msg}");
-    let e = plugin::build_policy("linear_thompson", &Params::json(r#"{"sample": 3}"#), &ctx())
-        .err()
-        .unwrap();
+    let e = plugin::build_policy(
+        "linear_thompson",
+        &Params::json(r#"{"sample": 3}"#),
+        &task(),
+    )
+    .err()
+    .unwrap();
     assert!(e.to_string().contains("unknown field `sample`"), "{e}");
 }
 

@@ -2,6 +2,7 @@
 //! is an error (or, for methods that cannot fail, a poisoned object whose
 //! next fallible call is an error), and the host process carries on.
 
+use hil_core::TaskContext;
 use hil_core::WorkloadInput;
 mod common;
 
@@ -17,6 +18,13 @@ fn load() {
 
 fn ctx() -> BuildContext {
     BuildContext::new(".", 0)
+}
+
+/// What policies and channels are built from: the six feeding actions and
+/// 4-d contexts.
+fn task() -> TaskContext {
+    let actions = ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap();
+    TaskContext::new(ctx(), actions, 4)
 }
 
 fn params(method: &str) -> Params {
@@ -71,7 +79,7 @@ fn observe(p: &mut dyn Policy) -> hil_core::Result<()> {
 #[test]
 fn policy_panics_are_errors() {
     load();
-    let build = |m: &str| plugin::build_policy("panicky_policy", &params(m), &ctx());
+    let build = |m: &str| plugin::build_policy("panicky_policy", &params(m), &task());
     assert_panicked(build("factory"), "factory");
     for cached in ["name", "n_arms", "dim"] {
         assert_panicked_in(build(cached), "name/n_arms/dim", cached);
@@ -165,7 +173,7 @@ fn workload_model_panics_are_errors() {
 #[test]
 fn query_channel_panics_are_errors() {
     load();
-    let build = |m: &str| plugin::build_query_channel("panicky_channel", &params(m), &ctx());
+    let build = |m: &str| plugin::build_query_channel("panicky_channel", &params(m), &task());
     assert_panicked(build("factory"), "factory");
     assert_panicked(build("name"), "name");
     let q = Query::new(

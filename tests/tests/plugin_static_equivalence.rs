@@ -2,6 +2,7 @@
 //! identical decisions for the same seed, and checkpoints cross the
 //! boundary both ways.
 
+use hil_core::TaskContext;
 mod common;
 
 use std::sync::Arc;
@@ -28,11 +29,12 @@ fn env() -> TableEnv {
     .unwrap()
 }
 
-fn ctx(dim: usize) -> BuildContext {
-    let mut ctx = BuildContext::new(".", 11);
-    ctx.action_space = Some(hil_envs::feeding::action_space());
-    ctx.context_dim = Some(dim);
-    ctx
+fn ctx(dim: usize) -> TaskContext {
+    TaskContext::new(
+        BuildContext::new(".", 11),
+        hil_envs::feeding::action_space(),
+        dim,
+    )
 }
 
 fn episodes(policy: &mut dyn Policy, n: usize) -> Vec<EpisodeReport> {

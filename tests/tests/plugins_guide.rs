@@ -7,7 +7,7 @@ mod common;
 use std::path::Path;
 
 use hil_core::plugin::{self, Params};
-use hil_core::{ActionSpace, BuildContext, ExperimentConfig};
+use hil_core::{ActionSpace, BuildContext, ExperimentConfig, TaskContext};
 
 fn guide() -> String {
     std::fs::read_to_string(common::workspace_root().join("PLUGINS.md")).unwrap()
@@ -66,9 +66,11 @@ fn the_guide_plugin_loads_conforms_and_runs_from_the_guide_config() {
     assert_eq!(info.components[0].name, "ask_first_items");
 
     // What `hil plugins check` does.
-    let mut ctx = BuildContext::new(".", 0);
-    ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
-    ctx.context_dim = Some(8);
+    let ctx = TaskContext::new(
+        BuildContext::new(".", 0),
+        ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap(),
+        8,
+    );
     let params = Params::toml("n_ask = 2");
     hil_core::testing::check_policy(&|| plugin::build_policy("ask_first_items", &params, &ctx))
         .unwrap();

@@ -9,9 +9,10 @@
 //!
 //! ```
 //! use hil_core::plugin::Params;
-//! use hil_core::BuildContext;
+//! use hil_core::{ActionSpace, BuildContext, TaskContext};
+//! let ctx = TaskContext::new(BuildContext::new(".", 1), ActionSpace::new(["a", "b"]).unwrap(), 4);
 //! let ch = hil_example_channel_noisy_expert::build(
-//!     &Params::toml("error = 0.2\ndecline = 0.1"), &BuildContext::new(".", 1)).unwrap();
+//!     &Params::toml("error = 0.2\ndecline = 0.1"), &ctx).unwrap();
 //! assert_eq!(ch.name(), "noisy_expert");
 //! ```
 
@@ -19,10 +20,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use hil_core::TaskContext;
 use hil_core::plugin::{Params, Registrar};
 use hil_core::{
-    Answer, ArmId, BuildContext, Difficulty, Distraction, HilError, Query, QueryChannel, Response,
-    Result,
+    Answer, ArmId, Difficulty, Distraction, HilError, Query, QueryChannel, Response, Result,
 };
 
 /// The name the plugin registers.
@@ -126,8 +127,11 @@ impl QueryChannel for NoisyExpert {
 }
 
 /// The factory.
-pub fn build(params: &Params, ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
-    Ok(Box::new(NoisyExpert::new(params.parse(NAME)?, ctx.seed)?))
+pub fn build(params: &Params, ctx: &TaskContext) -> Result<Box<dyn QueryChannel>> {
+    Ok(Box::new(NoisyExpert::new(
+        params.parse(NAME)?,
+        ctx.base().seed,
+    )?))
 }
 
 /// Registers the channel.
@@ -145,17 +149,20 @@ hil_core::declare_plugin!(register);
 mod tests {
     use super::*;
 
+    fn ctx() -> TaskContext {
+        let actions = hil_core::ActionSpace::new(["a", "b", "c"]).unwrap();
+        TaskContext::new(hil_core::BuildContext::new(".", 0), actions, 4)
+    }
+
     #[test]
     fn passes_the_channel_conformance_suite() {
-        let mut ch = build(&Params::empty(), &BuildContext::new(".", 0)).unwrap();
+        let mut ch = build(&Params::empty(), &ctx()).unwrap();
         hil_core::testing::check_query_channel(ch.as_mut(), 60).unwrap();
     }
 
     #[test]
     fn rejects_bad_parameters() {
-        let e = build(&Params::toml("error = 1.5"), &BuildContext::new(".", 0))
-            .err()
-            .unwrap();
+        let e = build(&Params::toml("error = 1.5"), &ctx()).err().unwrap();
         assert!(e.to_string().contains("`error`"), "{e}");
     }
 }

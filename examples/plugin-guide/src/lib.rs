@@ -8,11 +8,10 @@
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+use hil_core::TaskContext;
 use hil_core::plugin::{Params, Registrar};
 use hil_core::policy::{check_feedback, check_input};
-use hil_core::{
-    ArmId, BuildContext, Decision, DecisionInput, Feedback, HilError, Policy, QueryKind, Result,
-};
+use hil_core::{ArmId, Decision, DecisionInput, Feedback, HilError, Policy, QueryKind, Result};
 
 /// The parameters, as written in a config's `[policy]` section.
 #[derive(Debug, Deserialize)]
@@ -84,16 +83,10 @@ impl Policy for AskFirstItems {
 }
 
 /// Builds the policy from its parameters and the experiment's shape.
-pub fn build(params: &Params, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
+pub fn build(params: &Params, ctx: &TaskContext) -> Result<Box<dyn Policy>> {
     let p: AskFirstParams = params.parse("ask_first_items")?;
-    let n_arms = ctx.action_space.as_ref().map_or(0, |a| a.len());
-    let dim = ctx.context_dim.unwrap_or(0);
-    if n_arms == 0 || dim == 0 {
-        return Err(HilError::state(
-            "ask_first_items",
-            "needs the environment's action space and context dimension",
-        ));
-    }
+    // The context always knows the environment's shape: no check needed.
+    let (n_arms, dim) = (ctx.action_space().len(), ctx.context_dim());
     Ok(Box::new(AskFirstItems {
         n_ask: p.n_ask,
         dim,
@@ -119,9 +112,11 @@ mod tests {
 
     #[test]
     fn conforms() {
-        let mut ctx = BuildContext::new(".", 0);
-        ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
-        ctx.context_dim = Some(4);
+        let ctx = TaskContext::new(
+            hil_core::BuildContext::new(".", 0),
+            ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap(),
+            4,
+        );
         let params = Params::toml("n_ask = 2");
         hil_core::testing::check_policy(&|| build(&params, &ctx)).unwrap();
     }

@@ -16,11 +16,10 @@
 //! `linear_thompson`; as an `rlib` the same type can be linked statically.
 //!
 //! ```
-//! use hil_core::{ActionSpace, BuildContext, Policy};
+//! use hil_core::{ActionSpace, BuildContext, Policy, TaskContext};
 //! use hil_core::plugin::Params;
-//! let mut ctx = BuildContext::new(".", 7);
-//! ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
-//! ctx.context_dim = Some(4);
+//! let actions = ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap();
+//! let ctx = TaskContext::new(BuildContext::new(".", 7), actions, 4);
 //! let p = hil_example_policy_thompson::build(&Params::toml("confidence = 0.7"), &ctx).unwrap();
 //! assert_eq!((p.n_arms(), p.dim()), (6, 4));
 //! ```
@@ -30,11 +29,12 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+use hil_core::TaskContext;
 use hil_core::plugin::{Params, Registrar};
 use hil_core::policy::{check_feedback, check_input};
 use hil_core::{
-    ArmDiagnostics, ArmId, BuildContext, Decision, DecisionInput, Diagnostics, Feedback, HilError,
-    Policy, QueryKind, Result,
+    ArmDiagnostics, ArmId, Decision, DecisionInput, Diagnostics, Feedback, HilError, Policy,
+    QueryKind, Result,
 };
 
 /// The name the plugin registers.
@@ -314,17 +314,15 @@ impl Policy for LinearThompson {
 }
 
 /// The factory: parameters from `params`, shape and seed from `ctx`.
-pub fn build(params: &Params, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
+pub fn build(params: &Params, ctx: &TaskContext) -> Result<Box<dyn Policy>> {
     let p: ThompsonParams = params.parse(NAME)?;
-    let n_arms = ctx
-        .action_space
-        .as_ref()
-        .ok_or_else(|| HilError::state(NAME, "the build context has no action space"))?
-        .len();
-    let dim = ctx
-        .context_dim
-        .ok_or_else(|| HilError::state(NAME, "the build context has no context dimension"))?;
-    Ok(Box::new(LinearThompson::new(p, n_arms, dim, ctx.seed)?))
+    let (n_arms, dim) = (ctx.action_space().len(), ctx.context_dim());
+    Ok(Box::new(LinearThompson::new(
+        p,
+        n_arms,
+        dim,
+        ctx.base().seed,
+    )?))
 }
 
 /// Registers the policy type.
@@ -343,11 +341,12 @@ mod tests {
     use super::*;
     use hil_core::ActionSpace;
 
-    fn ctx() -> BuildContext {
-        let mut ctx = BuildContext::new(".", 3);
-        ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
-        ctx.context_dim = Some(5);
-        ctx
+    fn ctx() -> TaskContext {
+        TaskContext::new(
+            hil_core::BuildContext::new(".", 3),
+            ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap(),
+            5,
+        )
     }
 
     #[test]

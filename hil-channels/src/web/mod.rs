@@ -1,6 +1,7 @@
 //! A query channel served as a web page, for the person being fed: on a
 //! phone or tablet next to the robot, by touch, keyboard or single switch.
 
+use hil_core::TaskContext;
 pub mod http;
 pub mod urls;
 
@@ -13,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
 use hil_core::config::QueryChannelConfig;
-use hil_core::{Answer, ArmId, BuildContext, HilError, Query, QueryChannel, Response, Result};
+use hil_core::{Answer, ArmId, HilError, Query, QueryChannel, Response, Result};
 
 use crate::present::{describe_item, describe_kind, question, validate_answer};
 use http::{Limits, Occupancy, Request, Response as HttpResponse, Server, Service};
@@ -87,7 +88,7 @@ impl QueryChannelConfig for WebChannelConfig {
         hil_core::config::limits::check_seconds("timeout_s", self.timeout_s)
     }
 
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
+    fn build(&self, ctx: &TaskContext) -> Result<Box<dyn QueryChannel>> {
         let mut config = self.clone();
         config.images = config.images.map(|d| ctx.resolve(&d));
         Ok(Box::new(WebChannel::start(config)?))

@@ -12,6 +12,7 @@
 //! traffic (bytes per step, the bandwidth floor) is known only for the
 //! built-in estimator and is reported as absent for other policies.
 
+use hil_core::TaskContext;
 use hil_core::WorkloadInput;
 mod reproduce;
 mod spec;
@@ -210,10 +211,12 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
             });
         }
     }
-    let mut ctx = BuildContext::new(".", a.seed);
-    ctx.action_space = Some(ActionSpace::new((0..a.arms).map(|i| format!("arm{i}")))?);
-    ctx.context_dim = Some(a.dim);
-    ctx.pretraining = Some(Arc::from(data));
+    let ctx = TaskContext::new(
+        BuildContext::new(".", a.seed),
+        ActionSpace::new((0..a.arms).map(|i| format!("arm{i}")))?,
+        a.dim,
+    )
+    .with_pretraining(Arc::from(data));
 
     let t0 = Instant::now();
     let mut policy = config.build(&ctx)?;

@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use hil_core::TaskContext;
 use hil_core::plugin::{self, ComponentInfo, ComponentKind, Params, PluginInfo};
 use hil_core::testing::{
     ConformanceReport, check_environment, check_policy, check_query_channel, check_workload_model,
@@ -215,19 +216,21 @@ fn check_one(
     queries: usize,
     attempts: u32,
 ) -> Result<ConformanceReport, String> {
-    let mut ctx = BuildContext::new(".", 0);
-    ctx.action_space = Some(ActionSpace::clone(
-        hil_envs::feeding::FeedingTask::bundled().action_space(),
-    ));
-    ctx.context_dim = Some(dim);
+    let ctx = TaskContext::new(
+        BuildContext::new(".", 0),
+        ActionSpace::clone(hil_envs::feeding::FeedingTask::bundled().action_space()),
+        dim,
+    );
     let name = c.name.as_str();
     let r = match c.kind {
         ComponentKind::Policy => check_policy(&|| plugin::build_policy(name, params, &ctx)),
-        ComponentKind::Environment => {
-            check_environment(&|| plugin::build_environment(name, params, &ctx), attempts)
-        }
+        ComponentKind::Environment => check_environment(
+            &|| plugin::build_environment(name, params, ctx.base()),
+            attempts,
+        ),
         ComponentKind::WorkloadModel => {
-            let m = plugin::build_workload_model(name, params, &ctx).map_err(|e| e.to_string())?;
+            let m = plugin::build_workload_model(name, params, ctx.base())
+                .map_err(|e| e.to_string())?;
             check_workload_model(m.as_ref())
         }
         ComponentKind::QueryChannel => {

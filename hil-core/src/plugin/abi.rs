@@ -116,6 +116,7 @@ pub const fn interface_layout() -> u64 {
         crate::Result<()>,
         serde_json::Value,
         crate::BuildContext,
+        crate::TaskContext,
         crate::Context,
         crate::ActionSpace,
         crate::Item,

@@ -25,6 +25,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::registrar::{ComponentKind, Params};
 use super::registry;
+use crate::TaskContext;
 use crate::config::{
     BuildContext, EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig,
 };
@@ -53,7 +54,7 @@ impl PluginComponent {
 
 #[typetag::serde(name = "plugin")]
 impl PolicyConfig for PluginComponent {
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
+    fn build(&self, ctx: &TaskContext) -> Result<Box<dyn Policy>> {
         registry::build_policy(&self.name, &self.params()?, ctx)
     }
 }
@@ -74,7 +75,7 @@ impl WorkloadModelConfig for PluginComponent {
 
 #[typetag::serde(name = "plugin")]
 impl QueryChannelConfig for PluginComponent {
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn QueryChannel>> {
+    fn build(&self, ctx: &TaskContext) -> Result<Box<dyn QueryChannel>> {
         registry::build_query_channel(&self.name, &self.params()?, ctx)
     }
 }

@@ -15,7 +15,7 @@ use serde::de::DeserializeOwned;
 use super::guard::{
     self, DropPanicSink, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload,
 };
-use crate::config::BuildContext;
+use crate::config::{BuildContext, TaskContext};
 use crate::error::{HilError, Result};
 use crate::{Environment, Policy, QueryChannel, WorkloadModel};
 
@@ -140,15 +140,17 @@ impl Params {
 }
 
 /// Builds a policy from parameters and the experiment's build context.
-pub type PolicyFactory = FactoryOf<dyn Policy>;
+pub type PolicyFactory = FactoryOf<dyn Policy, TaskContext>;
 /// Builds an environment.
 pub type EnvironmentFactory = FactoryOf<dyn Environment>;
 /// Builds a workload model.
 pub type WorkloadModelFactory = FactoryOf<dyn WorkloadModel>;
 /// Builds a query channel.
-pub type QueryChannelFactory = FactoryOf<dyn QueryChannel>;
-/// Builds a component of type `T` from its parameters.
-pub type FactoryOf<T> = Arc<dyn Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync>;
+pub type QueryChannelFactory = FactoryOf<dyn QueryChannel, TaskContext>;
+/// Builds a component of type `T` from its parameters and a context `C`
+/// ([`BuildContext`] for environments and workload models, [`TaskContext`]
+/// for policies and query channels).
+pub type FactoryOf<T, C = BuildContext> = Arc<dyn Fn(&Params, &C) -> Result<Box<T>> + Send + Sync>;
 
 /// A factory of any kind.
 #[derive(Clone)]
@@ -245,7 +247,7 @@ impl<'a> Registrar<'a> {
     /// Registers a policy factory under `name`.
     pub fn policy<F>(&mut self, name: &str, description: &str, factory: F)
     where
-        F: Fn(&Params, &BuildContext) -> Result<Box<dyn Policy>> + Send + Sync + 'static,
+        F: Fn(&Params, &TaskContext) -> Result<Box<dyn Policy>> + Send + Sync + 'static,
     {
         let guard = |inner, lib, n: &str, sink| {
             Ok(
@@ -287,7 +289,7 @@ impl<'a> Registrar<'a> {
     /// Registers a query-channel factory under `name`.
     pub fn query_channel<F>(&mut self, name: &str, description: &str, factory: F)
     where
-        F: Fn(&Params, &BuildContext) -> Result<Box<dyn QueryChannel>> + Send + Sync + 'static,
+        F: Fn(&Params, &TaskContext) -> Result<Box<dyn QueryChannel>> + Send + Sync + 'static,
     {
         let guard = |inner, lib, n: &str, sink| {
             Ok(
@@ -302,16 +304,16 @@ impl<'a> Registrar<'a> {
     /// under the panic guard, and what it builds is wrapped by `guard` (so
     /// every later call into the object is guarded too) before the host
     /// gets it.
-    fn add<T: ?Sized + 'static>(
+    fn add<T: ?Sized + 'static, C: 'static>(
         &mut self,
         name: &str,
         description: &str,
-        factory: impl Fn(&Params, &BuildContext) -> Result<Box<T>> + Send + Sync + 'static,
+        factory: impl Fn(&Params, &C) -> Result<Box<T>> + Send + Sync + 'static,
         guard: GuardFn<T>,
-        kind: fn(FactoryOf<T>) -> Factory,
+        kind: fn(FactoryOf<T, C>) -> Factory,
     ) {
         let (lib, n, sink) = (self.library.clone(), name.to_string(), self.drop_sink);
-        let f = Arc::new(move |p: &Params, ctx: &BuildContext| {
+        let f = Arc::new(move |p: &Params, ctx: &C| {
             let inner = guard::call(&lib, &n, "factory", || factory(p, ctx))?;
             guard(inner, lib.clone(), &n, sink)
         });

@@ -7,7 +7,7 @@ use std::sync::{LazyLock, Mutex, RwLock};
 
 use super::abi::BuildFacts;
 use super::registrar::{ComponentKind, Factory, Params, PluginRegistrar, Registrar};
-use crate::config::BuildContext;
+use crate::config::{BuildContext, TaskContext};
 use crate::error::{HilError, Result};
 use crate::{Environment, Policy, QueryChannel, WorkloadModel};
 
@@ -157,9 +157,9 @@ fn rejected(kind: ComponentKind, name: &str, library: &Path, e: HilError) -> Hil
 }
 
 macro_rules! builder {
-    ($(#[$doc:meta])* $fn:ident, $variant:ident, $out:ty) => {
+    ($(#[$doc:meta])* $fn:ident, $variant:ident, $ctx:ty, $out:ty) => {
         $(#[$doc])*
-        pub fn $fn(name: &str, params: &Params, ctx: &BuildContext) -> Result<$out> {
+        pub fn $fn(name: &str, params: &Params, ctx: &$ctx) -> Result<$out> {
             let kind = ComponentKind::$variant;
             let (f, lib) = factory(kind, name)?;
             let Factory::$variant(f) = f else {
@@ -172,19 +172,19 @@ macro_rules! builder {
 
 builder!(
     /// Builds the plugin policy registered as `name`.
-    build_policy, Policy, Box<dyn Policy>
+    build_policy, Policy, TaskContext, Box<dyn Policy>
 );
 builder!(
     /// Builds the plugin environment registered as `name`.
-    build_environment, Environment, Box<dyn Environment>
+    build_environment, Environment, BuildContext, Box<dyn Environment>
 );
 builder!(
     /// Builds the plugin workload model registered as `name`.
-    build_workload_model, WorkloadModel, Box<dyn WorkloadModel>
+    build_workload_model, WorkloadModel, BuildContext, Box<dyn WorkloadModel>
 );
 builder!(
     /// Builds the plugin query channel registered as `name`.
-    build_query_channel, QueryChannel, Box<dyn QueryChannel>
+    build_query_channel, QueryChannel, TaskContext, Box<dyn QueryChannel>
 );
 
 /// Collects a library's registrations; nothing is committed until the

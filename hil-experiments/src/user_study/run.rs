@@ -6,7 +6,7 @@ use std::sync::Arc;
 use hil_core::metrics::mean_std;
 use hil_core::session::splitmix;
 use hil_core::{
-    BuildContext, Environment, EpisodeReport, Policy, Result, Session, SessionObserver,
+    Environment, EpisodeReport, Policy, Result, Session, SessionObserver, TaskContext,
     WorkloadModel,
 };
 use serde::{Deserialize, Serialize};
@@ -178,7 +178,7 @@ pub type Episode<'a> =
 /// run plates on an environment built from the same config.
 pub struct UserStudy<'c> {
     config: &'c UserStudyConfig,
-    ctx: BuildContext,
+    ctx: TaskContext,
     policies: Vec<Box<dyn Policy>>,
     workload: Arc<dyn WorkloadModel>,
 }
@@ -200,9 +200,9 @@ impl UserStudyConfig {
     /// offers, as in an experiment file.
     pub fn prepare(&self, base_dir: &Path, environment: &dyn Environment) -> Result<UserStudy<'_>> {
         self.validate()?;
-        let mut ctx = self.context(base_dir);
-        ctx.describe_environment(self.environment.as_ref(), environment)?;
-        let workload = self.workload.build(&ctx)?;
+        let base = self.context(base_dir);
+        let ctx = base.describe_environment(self.environment.as_ref(), environment)?;
+        let workload = self.workload.build(&base)?;
         let policies = self
             .methods
             .iter()

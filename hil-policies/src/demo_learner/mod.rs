@@ -10,11 +10,12 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+use hil_core::TaskContext;
 use hil_core::config::PolicyConfig;
 use hil_core::policy::{check_feedback, check_input};
 use hil_core::{
-    ArmDiagnostics, ArmId, BuildContext, Context, Decision, DecisionInput, Diagnostics, Feedback,
-    HilError, Policy, QueryKind, Result,
+    ArmDiagnostics, ArmId, Context, Decision, DecisionInput, Diagnostics, Feedback, HilError,
+    Policy, QueryKind, Result,
 };
 
 /// Config of the demo learner, `type = "demo_learner"`:
@@ -41,15 +42,13 @@ pub struct DemoLearnerConfig {
 
 #[typetag::serde(name = "demo_learner")]
 impl PolicyConfig for DemoLearnerConfig {
-    fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Policy>> {
+    fn build(&self, ctx: &TaskContext) -> Result<Box<dyn Policy>> {
         self.validate()?;
-        let (Some(actions), Some(dim)) = (&ctx.action_space, ctx.context_dim) else {
-            return Err(HilError::state(
-                "demo_learner",
-                "the environment must be built before the policy",
-            ));
-        };
-        Ok(Box::new(DemoLearner::new(actions.len(), dim, self.clone())))
+        Ok(Box::new(DemoLearner::new(
+            ctx.action_space().len(),
+            ctx.context_dim(),
+            self.clone(),
+        )))
     }
 
     fn validate(&self) -> Result<()> {
@@ -257,9 +256,11 @@ mod tests {
 
     #[test]
     fn configs_are_checked() {
-        let mut ctx = BuildContext::new(".", 0);
-        ctx.action_space = Some(hil_core::ActionSpace::new(["a", "b"]).unwrap());
-        ctx.context_dim = Some(3);
+        let ctx = TaskContext::new(
+            hil_core::BuildContext::new(".", 0),
+            hil_core::ActionSpace::new(["a", "b"]).unwrap(),
+            3,
+        );
         assert!(params(0.5, 0.1).build(&ctx).is_ok());
         for bad in [params(1.5, 0.1), params(0.5, -0.1)] {
             assert!(matches!(
@@ -267,9 +268,5 @@ mod tests {
                 Err(HilError::InvalidParameter { .. })
             ));
         }
-        assert!(matches!(
-            params(0.5, 0.1).build(&BuildContext::new(".", 0)),
-            Err(HilError::State { .. })
-        ));
     }
 }

@@ -185,10 +185,10 @@ impl QueryChannel for SimulatedExpert {
             ..
         } = self.truth.ask(query)?
         else {
-            return Err(HilError::Channel {
-                channel: self.name().into(),
-                why: "the perfect expert named no action".into(),
-            });
+            return Err(HilError::channel(
+                self.name(),
+                "the perfect expert named no action",
+            ));
         };
         let mut rng = ChaCha8Rng::seed_from_u64(splitmix(self.seed, query.t));
         // Draw every random quantity unconditionally, in a fixed order, so

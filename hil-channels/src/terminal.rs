@@ -95,10 +95,7 @@ impl<R: BufRead, W: Write> TerminalChannel<R, W> {
     }
 
     fn io_err(&self, e: std::io::Error) -> HilError {
-        HilError::Channel {
-            channel: "terminal".into(),
-            why: format!("terminal I/O failed: {e}"),
-        }
+        HilError::channel("terminal", format!("terminal I/O failed: {e}")).with_source(e)
     }
 
     fn show(&mut self, query: &Query) -> std::io::Result<()> {
@@ -216,14 +213,14 @@ impl<R: BufRead + Send, W: Write + Send> QueryChannel for TerminalChannel<R, W> 
                 .map_err(|e| self.io_err(e))?;
             if n == 0 {
                 let _ = writeln!(self.output);
-                return Err(HilError::Channel {
-                    channel: "terminal".into(),
-                    why: format!(
+                return Err(HilError::channel(
+                    "terminal",
+                    format!(
                         "input ended before the query at step {} was answered; the session \
                          stops here (resume it with `hil run --resume LOG`)",
                         query.t
                     ),
-                });
+                ));
             }
             match Self::parse(query, &line) {
                 Parsed::Answer(answer) => {
@@ -235,14 +232,14 @@ impl<R: BufRead + Send, W: Write + Send> QueryChannel for TerminalChannel<R, W> 
                     writeln!(self.output, "  {why}").map_err(|e| self.io_err(e))?;
                 }
                 Parsed::Quit => {
-                    return Err(HilError::Channel {
-                        channel: "terminal".into(),
-                        why: format!(
+                    return Err(HilError::channel(
+                        "terminal",
+                        format!(
                             "the session was stopped at the terminal at step {} (resume it with \
                              `hil run --resume LOG`)",
                             query.t
                         ),
-                    });
+                    ));
                 }
             }
         }

@@ -349,7 +349,7 @@ fn bad_configs_are_refused() {
     })
     .unwrap_err();
     match err {
-        hil_core::HilError::Channel { channel, why } => {
+        hil_core::HilError::Channel { channel, why, .. } => {
             assert_eq!(channel, "web");
             assert!(why.contains(&addr.to_string()), "{why}");
         }

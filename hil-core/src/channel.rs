@@ -73,10 +73,11 @@ impl QueryChannel for PerfectExpert {
     }
 
     fn ask(&mut self, query: &Query) -> Result<Response> {
-        let arm = query.oracle_best.ok_or_else(|| HilError::Channel {
-            channel: Self::NAME.into(),
-            why: "the environment does not know its best action, so a perfect expert cannot answer"
-                .into(),
+        let arm = query.oracle_best.ok_or_else(|| {
+            HilError::channel(
+                Self::NAME,
+                "the environment does not know its best action, so a perfect expert cannot answer",
+            )
         })?;
         query.actions.check(arm)?;
         self.asked += 1;

@@ -9,6 +9,10 @@ use std::path::PathBuf;
 /// Result alias used across hil.
 pub type Result<T, E = HilError> = std::result::Result<T, E>;
 
+/// An underlying error kept as an [`HilError`]'s source, so a caller can
+/// walk the chain or downcast it (e.g. to the simulator's own error type).
+pub type BoxError = Box<dyn std::error::Error + Send + Sync + 'static>;
+
 /// Errors raised by hil components.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -74,12 +78,23 @@ pub enum HilError {
         why: String,
     },
     /// (De)serialising state or parameters failed.
-    #[error("serialisation of {what} failed: {why}")]
+    #[error("serialisation of {what} failed: {source}")]
     Serde {
         /// What was being (de)serialised.
         what: String,
-        /// The underlying message.
-        why: String,
+        /// The serialiser's error (e.g. a `serde_json::Error`).
+        #[source]
+        source: BoxError,
+    },
+    /// A numerical routine failed (e.g. a factorisation met a matrix that is
+    /// not positive definite).
+    #[error("{what}: {source}")]
+    Numerical {
+        /// What was being computed.
+        what: String,
+        /// The linear-algebra library's error.
+        #[source]
+        source: BoxError,
     },
     /// A component is in a state where the call makes no sense
     /// (e.g. `execute` before `next_item`).
@@ -97,6 +112,9 @@ pub enum HilError {
         channel: String,
         /// What happened.
         why: String,
+        /// The underlying error (e.g. the terminal's I/O error), if any.
+        #[source]
+        source: Option<BoxError>,
     },
     /// A simulator or external backend failed (diverged, crashed, missing library).
     #[error("backend `{backend}` failed: {why}")]
@@ -105,6 +123,9 @@ pub enum HilError {
         backend: String,
         /// What happened.
         why: String,
+        /// The backend's own error (e.g. `hil_kinova_mujoco::KinovaError`), if any.
+        #[source]
+        source: Option<BoxError>,
     },
     /// A plugin failed to load, handshake or run.
     #[error("plugin {}: {why}", path.display())]
@@ -168,11 +189,64 @@ impl HilError {
         }
     }
 
-    /// Shorthand for [`HilError::Serde`].
-    pub fn serde(what: impl Into<String>, why: impl std::fmt::Display) -> Self {
+    /// Shorthand for [`HilError::Serde`]: `source` is the serialiser's error
+    /// (kept as the source) or a message.
+    pub fn serde(what: impl Into<String>, source: impl Into<BoxError>) -> Self {
         Self::Serde {
             what: what.into(),
-            why: why.to_string(),
+            source: source.into(),
+        }
+    }
+
+    /// Shorthand for [`HilError::Numerical`].
+    pub fn numerical(what: impl Into<String>, source: impl Into<BoxError>) -> Self {
+        Self::Numerical {
+            what: what.into(),
+            source: source.into(),
+        }
+    }
+
+    /// A [`HilError::Channel`] saying why `channel` failed.
+    pub fn channel(channel: impl Into<String>, why: impl Into<String>) -> Self {
+        Self::Channel {
+            channel: channel.into(),
+            why: why.into(),
+            source: None,
+        }
+    }
+
+    /// A [`HilError::Backend`] saying why `backend` failed.
+    pub fn backend(backend: impl Into<String>, why: impl Into<String>) -> Self {
+        Self::Backend {
+            backend: backend.into(),
+            why: why.into(),
+            source: None,
+        }
+    }
+
+    /// The same [`HilError::Channel`] or [`HilError::Backend`] error with
+    /// `source` kept as its cause; other errors as they are.
+    ///
+    /// ```
+    /// use std::error::Error;
+    /// use hil_core::HilError;
+    /// let io = std::io::Error::other("pipe closed");
+    /// let e = HilError::channel("terminal", "terminal I/O failed").with_source(io);
+    /// assert_eq!(e.source().unwrap().to_string(), "pipe closed");
+    /// ```
+    pub fn with_source(self, cause: impl Into<BoxError>) -> Self {
+        match self {
+            Self::Channel { channel, why, .. } => Self::Channel {
+                channel,
+                why,
+                source: Some(cause.into()),
+            },
+            Self::Backend { backend, why, .. } => Self::Backend {
+                backend,
+                why,
+                source: Some(cause.into()),
+            },
+            other => other,
         }
     }
 

@@ -53,7 +53,7 @@ pub use decision::{
     ArmDiagnostics, Choice, Decision, Diagnostics, Extras, LabelledObservation, Outcome,
 };
 pub use environment::{CallOrder, Environment, Item};
-pub use error::{HilError, Result};
+pub use error::{BoxError, HilError, Result};
 pub use experiment::{Experiment, ExperimentSummary};
 pub use metrics::EpisodeMetrics;
 pub use policy::{DecisionInput, Feedback, Policy};

@@ -62,9 +62,8 @@ pub enum KinovaError {
 
 impl From<KinovaError> for HilError {
     fn from(e: KinovaError) -> Self {
-        HilError::Backend {
-            backend: "mujoco".into(),
-            why: e.to_string(),
-        }
+        // The simulator's error is kept as the source, so a caller can
+        // downcast to it rather than parse the message.
+        HilError::backend("mujoco", e.to_string()).with_source(e)
     }
 }

@@ -96,9 +96,11 @@ impl QueryChannel for NoisyExpert {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
     }
     fn ask(&mut self, query: &Query) -> Result<Response> {
-        let best = query.oracle_best.ok_or_else(|| HilError::Channel {
-            channel: NAME.into(),
-            why: "the simulated expert needs an environment that knows its best action".into(),
+        let best = query.oracle_best.ok_or_else(|| {
+            HilError::channel(
+                NAME,
+                "the simulated expert needs an environment that knows its best action",
+            )
         })?;
         let n = query.actions.len();
         query.actions.check(best)?;

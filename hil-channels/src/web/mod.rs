@@ -222,10 +222,7 @@ impl WebChannel {
             state: Mutex::new(State::default()),
             answered: Condvar::new(),
         });
-        let channel_error = |why: String| HilError::Channel {
-            channel: "web".into(),
-            why,
-        };
+        let channel_error = |why: String| HilError::channel("web", why);
         let server = Server::start(bind, Arc::new(Page(shared.clone())), Limits::default())
             .map_err(|e| channel_error(format!("cannot listen on {bind}: {e}")))?;
         let addr = server.addr();

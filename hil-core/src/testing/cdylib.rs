@@ -67,10 +67,10 @@ pub fn build_cdylibs(workspace: &Path, crates: &[&str]) -> Result<PathBuf> {
         .output()
         .map_err(|e| HilError::io("running", "cargo build", e))?;
     if !out.status.success() {
-        return Err(HilError::Backend {
-            backend: "cargo build".into(),
-            why: String::from_utf8_lossy(&out.stderr).into_owned(),
-        });
+        return Err(HilError::backend(
+            "cargo build",
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        ));
     }
     Ok(target.join(profile))
 }

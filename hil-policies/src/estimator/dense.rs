@@ -40,10 +40,7 @@ impl DenseArm {
             }
         }
         let llt = a.llt(Side::Lower).map_err(|e| {
-            HilError::state(
-                "linear arms",
-                format!("Cholesky factorisation of λI + XᵀX failed: {e:?}"),
-            )
+            HilError::numerical("linear arms: Cholesky factorisation of λI + XᵀX", e)
         })?;
         let lm = llt.L();
         let mut l = Vec::with_capacity(packed_len(dim));

@@ -55,9 +55,9 @@ impl KernelArm {
             k[(i, i)] += lambda;
         }
         let llt = k.llt(Side::Lower).map_err(|e| {
-            HilError::state(
-                "linear arms",
-                format!("Cholesky factorisation of the kernel matrix failed: {e:?}"),
+            HilError::numerical(
+                "linear arms: Cholesky factorisation of the kernel matrix",
+                e,
             )
         })?;
         let lm = llt.L();

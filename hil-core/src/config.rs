@@ -297,6 +297,58 @@ pub trait QueryChannelConfig: std::fmt::Debug + Send + Sync {
 }
 
 /// A complete experiment: the components and how to run them.
+///
+/// Read from TOML (see `examples/configs/` for the built-in types); here
+/// with components registered in code, as a downstream crate would:
+///
+/// ```
+/// use std::path::Path;
+/// use hil_core::plugin::{self, Params};
+/// use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
+/// use hil_core::{ActionSpace, ArmId, Choice, ExperimentConfig, HilError, PerfectExpert};
+///
+/// plugin::register_static(Path::new("experiment-doc"), |r| {
+///     r.environment("doc_plate", "two foods", |_p: &Params, _ctx| {
+///         let actions = ActionSpace::new(["skewer", "scoop"])?;
+///         Ok(Box::new(TableEnv::new(actions, vec![("pea", vec![0.2, 0.9]), ("cube", vec![0.8, 0.3])])?))
+///     });
+///     r.policy("doc_always_skewer", "always the first action", |_p, ctx| {
+///         let first = vec![Choice::Act { arm: ArmId(0) }];
+///         Ok(Box::new(ScriptedPolicy::new(ctx.action_space().len(), ctx.context_dim(), first)))
+///     });
+///     r.workload_model("doc_counting", "a step per query", |_p, _ctx| {
+///         Ok(Box::new(CountingWorkload::new(0.1)))
+///     });
+///     r.query_channel("doc_expert", "the perfect expert", |_p, _ctx| {
+///         Ok(Box::new(PerfectExpert::default()))
+///     });
+/// })?;
+///
+/// let text = r#"
+/// seed = 3
+/// episodes = 2
+/// [session]
+/// n_att = 2
+/// [environment]
+/// type = "doc_plate"
+/// [policy]
+/// type = "doc_always_skewer"
+/// [workload]
+/// type = "doc_counting"
+/// [channel]
+/// type = "doc_expert"
+/// "#;
+/// let config = ExperimentConfig::parse(text, Path::new("doc.toml"))?;
+/// let mut experiment = config.build(Path::new("."))?;
+/// let summary = experiment.run(&mut [], |_, _| {})?;
+/// assert_eq!(summary.episodes.len(), 2);
+/// assert!(summary.episodes.iter().all(|m| m.n_items == 2 && m.n_q == 0));
+///
+/// // A mistake is reported with the file, line and field.
+/// let e = ExperimentConfig::parse(&text.replace("n_att = 2", "n_att = 0"), Path::new("doc.toml"));
+/// assert!(e.unwrap_err().to_string().contains("doc.toml"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ExperimentConfig {

@@ -118,6 +118,26 @@ mod tests {
         d.query_probability = Some(f64::NAN);
         let e = diagnostics("p", &d).unwrap_err().to_string();
         assert!(e.contains("diagnostics.query_probability"), "{e}");
+        d.query_probability = None;
+        d.extra.insert("agreement", f64::NAN);
+        match diagnostics("p", &d).unwrap_err() {
+            HilError::InvalidInput { what, .. } => {
+                assert_eq!(what, "`diagnostics.extra.agreement` of policy `p`")
+            }
+            e => panic!("{e:?}"),
+        }
+    }
+
+    #[test]
+    fn extras_round_trip_and_are_left_out_when_empty() {
+        let d = Diagnostics::new()
+            .with_gap(0.5)
+            .with_extra("agreement", 0.75);
+        let json = serde_json::to_string(&d).unwrap();
+        assert_eq!(json, r#"{"gap":0.5,"extra":{"agreement":0.75}}"#);
+        assert_eq!(serde_json::from_str::<Diagnostics>(&json).unwrap(), d);
+        let plain = serde_json::to_string(&Diagnostics::new().with_gap(0.5)).unwrap();
+        assert_eq!(plain, r#"{"gap":0.5}"#);
     }
 
     #[test]

@@ -56,14 +56,9 @@ impl QueryChannelConfig for TerminalChannelConfig {
 /// let input: &[u8] = b"7\n2\n";  // 7 is out of range: asked again
 /// let mut out = Vec::new();
 /// let mut ch = TerminalChannel::new(input, &mut out);
-/// let q = Query {
-///     t: 1,
-///     item: Item { index: 0, label: "banana".into(), description: None },
-///     kind: QueryKind::default(),
-///     actions: hil_envs::feeding::action_space(),
-///     context: Context::new(vec![0.0]).unwrap(),
-///     oracle_best: None,
-/// };
+/// let actions = hil_envs::feeding::action_space();
+/// let context = Context::new(vec![0.0]).unwrap();
+/// let q = Query::new(1, Item::new(0, "banana"), QueryKind::default(), actions, context);
 /// assert_eq!(ch.ask(&q).unwrap().expert_arm, Some(ArmId(1)));
 /// drop(ch);
 /// assert!(String::from_utf8(out).unwrap().contains("2) VS90"));

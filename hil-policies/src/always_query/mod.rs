@@ -40,10 +40,7 @@ impl AlwaysQueryParams {
 /// let mut p = AlwaysQuery::new(params, LinearArms::new(2, 2, 1.0).unwrap());
 /// let x = Context::new(vec![0.0, 1.0]).unwrap();
 /// let h = QueryHistory::new();
-/// let input = DecisionInput {
-///     context: &x, t: 1, item_index: 0, items_seen: 0, attempt: 0,
-///     workload: WorkloadForecast::none(&h),
-/// };
+/// let input = DecisionInput::new(&x, 1, WorkloadForecast::none(&h));
 /// assert!(matches!(p.decide(&input).unwrap().choice, Choice::Query { .. }));
 /// ```
 pub type AlwaysQuery = LinearPolicy<AlwaysQueryParams>;

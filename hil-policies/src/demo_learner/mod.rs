@@ -80,14 +80,7 @@ impl PolicyConfig for DemoLearnerConfig {
 /// let mut learner = DemoLearner::new(3, 2, params);
 /// let context = Context::new(vec![1.0, 0.0])?;
 /// let history = QueryHistory::new();
-/// let input = DecisionInput {
-///     context: &context,
-///     t: 1,
-///     item_index: 0,
-///     items_seen: 0,
-///     attempt: 0,
-///     workload: WorkloadForecast::none(&history),
-/// };
+/// let input = DecisionInput::new(&context, 1, WorkloadForecast::none(&history));
 /// // With query_probability = 1 it asks at every first attempt.
 /// assert!(matches!(learner.decide(&input)?.choice, Choice::Query { .. }));
 /// # Ok::<(), hil_core::HilError>(())

@@ -69,12 +69,9 @@ impl LinUcbExpDecayParams {
 /// p.seed(7);
 /// let x = Context::new(vec![0.0, 1.0]).unwrap();
 /// let h = QueryHistory::new();
-/// let mut input = DecisionInput {
-///     context: &x, t: 1, item_index: 3, items_seen: 3, attempt: 0,
-///     workload: WorkloadForecast::none(&h),
-/// };
+/// let input = DecisionInput::new(&x, 1, WorkloadForecast::none(&h)).at_item(3, 3, 0);
 /// assert!(matches!(p.decide(&input).unwrap().choice, Choice::Query { .. }));
-/// input.attempt = 1; // later attempts never query
+/// let input = input.at_item(3, 3, 1); // later attempts never query
 /// assert!(matches!(p.decide(&input).unwrap().choice, Choice::Act { .. }));
 /// ```
 pub type LinUcbExpDecay = LinearPolicy<LinUcbExpDecayParams>;

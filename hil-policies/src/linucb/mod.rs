@@ -35,10 +35,7 @@ impl LinUcbParams {
 /// let mut p = LinUcb::new(LinUcbParams::new(1.0).unwrap(), LinearArms::new(3, 2, 1.0).unwrap());
 /// let x = Context::new(vec![1.0, 0.0]).unwrap();
 /// let h = QueryHistory::new();
-/// let input = DecisionInput {
-///     context: &x, t: 1, item_index: 0, items_seen: 0, attempt: 0,
-///     workload: WorkloadForecast::none(&h),
-/// };
+/// let input = DecisionInput::new(&x, 1, WorkloadForecast::none(&h));
 /// let d = p.decide(&input).unwrap();
 /// assert!(matches!(d.choice, Choice::Act { .. }));
 /// assert_eq!(d.diagnostics.arms.len(), 3);

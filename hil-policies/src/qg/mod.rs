@@ -52,10 +52,7 @@ impl LinUcbQgParams {
 /// let mut p = LinUcbQg::new(params, LinearArms::new(2, 2, 1.0).unwrap());
 /// let x = Context::new(vec![0.0, 1.0]).unwrap();
 /// let (model, h) = (CountingWorkload::new(0.1), QueryHistory::new());
-/// let input = DecisionInput {
-///     context: &x, t: 1, item_index: 0, items_seen: 0, attempt: 0,
-///     workload: WorkloadForecast::new(Some(&model), 0.5, &h, 1),
-/// };
+/// let input = DecisionInput::new(&x, 1, WorkloadForecast::new(Some(&model), 0.5, &h, 1));
 /// // Nothing learnt yet: G = 2α·b = 2 > w·WL = 0.5 · 0.6.
 /// let d = p.decide(&input).unwrap();
 /// assert!(matches!(d.choice, Choice::Query { .. }));

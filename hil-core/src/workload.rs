@@ -81,6 +81,19 @@ impl QueryHistory {
         self.records.is_empty()
     }
 
+    /// Number of queries asked at or before `t`.
+    ///
+    /// ```
+    /// use hil_core::{QueryHistory, QueryKind};
+    /// let mut h = QueryHistory::new();
+    /// h.push(2, QueryKind::default()).unwrap();
+    /// h.push(5, QueryKind::default()).unwrap();
+    /// assert_eq!((h.count_until(1), h.count_until(2), h.count_until(9)), (0, 1, 2));
+    /// ```
+    pub fn count_until(&self, t: Timestep) -> usize {
+        self.records.iter().filter(|r| r.t <= t).count()
+    }
+
     /// The time of the last query, if any.
     pub fn last_time(&self) -> Option<Timestep> {
         self.records.last().map(|r| r.t)

@@ -157,12 +157,7 @@ impl WorkloadModel for PerQuery {
         "per_query"
     }
     fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
-        let n = input
-            .history
-            .records()
-            .iter()
-            .filter(|r| r.t <= input.t)
-            .count();
+        let n = input.history.count_until(input.t);
         Ok((input.wl0 + 0.05 * n as f64).min(1.0))
     }
 }

@@ -241,12 +241,7 @@ impl WorkloadModel for CountingWorkload {
         "counting"
     }
     fn predict(&self, input: &WorkloadInput<'_>) -> Result<f64> {
-        let n = input
-            .history
-            .records()
-            .iter()
-            .filter(|r| r.t <= input.t)
-            .count();
+        let n = input.history.count_until(input.t);
         Ok((input.wl0 + self.increment * n as f64).clamp(0.0, 1.0))
     }
 }

@@ -22,6 +22,7 @@
 
 pub mod present;
 pub mod simulated;
+pub mod study;
 pub mod terminal;
 pub mod web;
 

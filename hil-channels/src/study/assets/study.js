@@ -83,13 +83,13 @@
       $("status").textContent = part + ": ready when you are.";
       $("start").focus();
     } else if (v.phase === "task") {
-      showTask(v);
       setHidden("task", false);
+      showTask(v);
       if (v.query) {
         showQuery(v.query);
         setHidden("query", false);
         $("status").textContent = part + ": the robot has a question.";
-        const first = document.querySelector("#query fieldset:not([hidden]) button, #query fieldset:not([hidden]) textarea, #box-canvas");
+        const first = document.querySelector("#query fieldset:not([hidden]) button, #query fieldset:not([hidden]) textarea, #query fieldset:not([hidden]) canvas");
         $("query-question").setAttribute("tabindex", "-1");
         (first || $("query-question")).focus();
       } else {

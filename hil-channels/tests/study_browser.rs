@@ -96,9 +96,21 @@ fn audit(b: &Browser, what: &str) {
            out.overflow = document.documentElement.scrollWidth > window.innerWidth;
            return out;"#,
     );
-    assert_eq!(audit["unnamed"], json!([]), "{what}: controls without a label");
-    assert_eq!(audit["small"], json!([]), "{what}: touch targets under 44 px");
-    assert_eq!(audit["overflow"], json!(false), "{what}: horizontal scrolling on a phone");
+    assert_eq!(
+        audit["unnamed"],
+        json!([]),
+        "{what}: controls without a label"
+    );
+    assert_eq!(
+        audit["small"],
+        json!([]),
+        "{what}: touch targets under 44 px"
+    );
+    assert_eq!(
+        audit["overflow"],
+        json!(false),
+        "{what}: horizontal scrolling on a phone"
+    );
     for c in audit["colours"].as_array().unwrap() {
         let ratio = contrast(c[1].as_str().unwrap(), c[2].as_str().unwrap());
         assert!(ratio >= 4.5, "{what}: {} contrast {ratio:.2}", c[0]);
@@ -126,7 +138,10 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
     let mut audited = std::collections::BTreeSet::new();
     let deadline = Instant::now() + Duration::from_secs(300);
     loop {
-        assert!(Instant::now() < deadline, "the study did not finish; seen {seen:?}");
+        assert!(
+            Instant::now() < deadline,
+            "the study did not finish; seen {seen:?}"
+        );
         let s = page_state(&b);
         let mut check = |what: &str| {
             if audited.insert(what.to_string()) {
@@ -137,7 +152,11 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
             break;
         } else if s["intro"] == json!(true) {
             check("intro");
-            assert!(wait_focus(&b, &["start"]), "focus is on Start: {}", page_state(&b));
+            assert!(
+                wait_focus(&b, &["start"]),
+                "focus is on Start: {}",
+                page_state(&b)
+            );
             b.keys(&[ENTER]);
             let until = Instant::now() + Duration::from_secs(10);
             while page_state(&b)["intro"] == json!(true) && Instant::now() < until {
@@ -147,7 +166,10 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
             check("survey");
             let legend = s["first_legend"].as_str().unwrap();
             assert!(legend.contains("mentally or physically"), "{legend}");
-            assert!(wait_focus(&b, &["tlx-mental-1"]), "focus is on the first answer");
+            assert!(
+                wait_focus(&b, &["tlx-mental-1"]),
+                "focus is on the first answer"
+            );
             // Answer 1..5 as Space then ArrowRight × (v − 1), Tab to the next.
             for (i, v) in [3usize, 2, 4, 3, 1].iter().enumerate() {
                 let mut keys = vec![SPACE];
@@ -179,8 +201,12 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
                 "bounding_box" => {
                     assert!(wait_focus(&b, &["box-canvas"]));
                     b.keys(&[RIGHT, RIGHT]); // moves the default box (40%..60%) 2% a press
-                    let readout = b.script("return document.getElementById('box-readout').textContent;");
-                    assert!(readout.as_str().unwrap().starts_with("Box: left 44%"), "{readout}");
+                    let readout =
+                        b.script("return document.getElementById('box-readout').textContent;");
+                    assert!(
+                        readout.as_str().unwrap().starts_with("Box: left 44%"),
+                        "{readout}"
+                    );
                     let tabs: Vec<&str> = std::iter::repeat_n(TAB, 10).collect();
                     b.keys(&tabs);
                     assert!(wait_focus(&b, &["send-box"]));
@@ -193,7 +219,10 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
                 }
             }
             let until = Instant::now() + Duration::from_secs(10);
-            while page_state(&b)["query"].is_string() && page_state(&b)["survey"] != json!(true) && Instant::now() < until {
+            while page_state(&b)["query"].is_string()
+                && page_state(&b)["survey"] != json!(true)
+                && Instant::now() < until
+            {
                 std::thread::sleep(Duration::from_millis(30));
             }
         } else if s["addition"] == json!(true) && s["focus"] == json!("sum-answer") {

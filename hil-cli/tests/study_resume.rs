@@ -123,7 +123,9 @@ fn answer(url: &str, v: &Value) {
     let q = &v["query"];
     let answer = match q["kind"].as_str().unwrap() {
         "mcq" => json!({"type": "label", "label": q["options"][0]}),
-        "bounding_box" => json!({"type": "bounding_box", "bbox": {"x0": 0.1, "y0": 0.1, "x1": 0.4, "y1": 0.5}}),
+        "bounding_box" => {
+            json!({"type": "bounding_box", "bbox": {"x0": 0.1, "y0": 0.1, "x1": 0.4, "y1": 0.5}})
+        }
         _ => json!({"type": "text", "text": "too soft"}),
     };
     let (s, r) = request(
@@ -166,12 +168,23 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
     // Baseline: start, wait for its end survey, submit.
     let v = until(&p, "intro", |v| v["phase"] == "intro");
     assert_eq!(v["condition"]["id"], "baseline_easy");
-    assert_eq!(request(&p, "api/start", Some(&json!({"condition": "baseline_easy"}))).0, 200);
+    assert_eq!(
+        request(
+            &p,
+            "api/start",
+            Some(&json!({"condition": "baseline_easy"}))
+        )
+        .0,
+        200
+    );
     until(&p, "baseline survey", |v| v["phase"] == "survey");
     survey(&p, "baseline_easy", Value::Null, 2);
     // c01: two queries with their surveys, a third answered, then kill.
     until(&p, "c01 intro", |v| v["phase"] == "intro");
-    assert_eq!(request(&p, "api/start", Some(&json!({"condition": "c01"}))).0, 200);
+    assert_eq!(
+        request(&p, "api/start", Some(&json!({"condition": "c01"}))).0,
+        200
+    );
     for k in 0..3 {
         let v = until(&p, "a query", |v| v["query"]["number"] == json!(k));
         answer(&p, &v);
@@ -184,7 +197,10 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
     a.child.wait().unwrap();
     let before = events(&data);
     assert_eq!(
-        before.iter().filter(|e| e["event"] == "survey_submitted").count(),
+        before
+            .iter()
+            .filter(|e| e["event"] == "survey_submitted")
+            .count(),
         3
     );
 
@@ -193,8 +209,17 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
     let (s, progress) = request(&b.researcher, "api/progress", None);
     assert_eq!(s, 200);
     let row = &progress["participants"][0];
-    assert_eq!((row["participant"].as_str(), row["surveys"].as_u64()), (Some("p001"), Some(3)));
-    let host = b.researcher.trim_start_matches("http://").split('/').next().unwrap().to_string();
+    assert_eq!(
+        (row["participant"].as_str(), row["surveys"].as_u64()),
+        (Some("p001"), Some(3))
+    );
+    let host = b
+        .researcher
+        .trim_start_matches("http://")
+        .split('/')
+        .next()
+        .unwrap()
+        .to_string();
     let p = format!("http://{host}{}", row["link"].as_str().unwrap());
     // Where they were: the survey after query 2 is due.
     let v = until(&p, "the pending survey", |v| v["phase"] == "survey");
@@ -206,10 +231,14 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
     for k in 3..5 {
         let v = until(&p, "a query", |v| v["query"]["number"] == json!(k));
         answer(&p, &v);
-        until(&p, "its survey", |v| v["phase"] == "survey" && v["survey"]["query"] == json!(k));
+        until(&p, "its survey", |v| {
+            v["phase"] == "survey" && v["survey"]["query"] == json!(k)
+        });
         survey(&p, "c01", json!(k), 3);
     }
-    until(&p, "the end survey", |v| v["phase"] == "survey" && v["survey"]["query"].is_null());
+    until(&p, "the end survey", |v| {
+        v["phase"] == "survey" && v["survey"]["query"].is_null()
+    });
     survey(&p, "c01", Value::Null, 3);
     until(&p, "done", |v| v["phase"] == "done");
     b.child.kill().unwrap();
@@ -220,17 +249,35 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
     assert_eq!(after[..before.len()], before[..]);
     let mut keys = std::collections::BTreeSet::new();
     for e in after.iter().filter(|e| e["event"] == "survey_submitted") {
-        assert!(keys.insert((e["condition"].to_string(), e["query"].to_string())), "duplicate survey {e}");
+        assert!(
+            keys.insert((e["condition"].to_string(), e["query"].to_string())),
+            "duplicate survey {e}"
+        );
     }
     assert_eq!(keys.len(), 7); // baseline end, 5 query surveys, c01 end
 
     // The README's loop: export, summary, fit, run with the model.
     let csv = dir.join("study.csv");
-    let out = common::hil(&["study", "export", "--data", data.to_str().unwrap(), "--out", csv.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = common::hil(&[
+        "study",
+        "export",
+        "--data",
+        data.to_str().unwrap(),
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = common::hil(&["workload", "summary", "--data", csv.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let pairs = |id: &str| {
         text.lines()
             .find(|l| l.trim_start().starts_with(id))
@@ -239,15 +286,35 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
     };
     assert!(pairs("D2").starts_with("D2: 5 pairs"), "{text}");
     assert!(pairs("D12").starts_with("D12: 5 pairs"), "{text}");
-    assert!(!text.contains("D1:"), "no participant without a limitation: {text}");
+    assert!(
+        !text.contains("D1:"),
+        "no participant without a limitation: {text}"
+    );
     let status = common::hil(&["study", "status", "--data", data.to_str().unwrap()]);
-    assert!(String::from_utf8_lossy(&status.stdout).contains("p001 mobility_limitation: 2/2 conditions, 7 surveys"));
+    assert!(
+        String::from_utf8_lossy(&status.stdout)
+            .contains("p001 mobility_limitation: 2/2 conditions, 7 surveys")
+    );
     let model = dir.join("m.json");
     let out = common::hil(&[
-        "workload", "fit", "--data", csv.to_str().unwrap(), "--population", "d12", "--model", "granger_n",
-        "--history", "1", "--out", model.to_str().unwrap(),
+        "workload",
+        "fit",
+        "--data",
+        csv.to_str().unwrap(),
+        "--population",
+        "d12",
+        "--model",
+        "granger_n",
+        "--history",
+        "1",
+        "--out",
+        model.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     hil_workload::load_model_json(&model).unwrap();
     // LinUCB-QG with the fitted model: the quickstart experiment with the
     // README's `[workload]` table.
@@ -264,7 +331,16 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
     );
     assert!(run.contains("type = \"linucb_qg\""));
     std::fs::write(dir.join("run.toml"), run).unwrap();
-    let out = common::hil(&["run", "--config", dir.join("run.toml").to_str().unwrap(), "--json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = common::hil(&[
+        "run",
+        "--config",
+        dir.join("run.toml").to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

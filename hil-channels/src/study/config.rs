@@ -212,8 +212,9 @@ impl StudyConfig {
 }
 
 fn check_minutes(name: &str, value: f64) -> Result<()> {
-    check_seconds(name, value * 60.0)
-        .map_err(|_| HilError::invalid_parameter(name, value, "must be a positive number of minutes"))
+    check_seconds(name, value * 60.0).map_err(|_| {
+        HilError::invalid_parameter(name, value, "must be a positive number of minutes")
+    })
 }
 
 fn check_distinct<T: PartialEq + std::fmt::Debug>(name: &str, values: &[T]) -> Result<()> {

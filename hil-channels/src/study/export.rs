@@ -30,7 +30,10 @@ pub fn export(dir: &Path) -> Result<Study> {
     let config = stored_design(dir)?.ok_or_else(|| {
         HilError::invalid_input(
             "data folder",
-            format!("{} has no design.json: not a study data folder", dir.display()),
+            format!(
+                "{} has no design.json: not a study data folder",
+                dir.display()
+            ),
         )
     })?;
     let design = Design::new(config)?;
@@ -43,7 +46,12 @@ pub fn export(dir: &Path) -> Result<Study> {
             ..
         }) = lines.first().map(|l| &l.event)
         else {
-            return Err(hil_core::textdata::data_error(&path, 1, "event", "the first line must be `enrolled`"));
+            return Err(hil_core::textdata::data_error(
+                &path,
+                1,
+                "event",
+                "the first line must be `enrolled`",
+            ));
         };
         // When each query of each condition appeared.
         let mut shown = std::collections::HashMap::new();
@@ -56,7 +64,10 @@ pub fn export(dir: &Path) -> Result<Study> {
                     difficulty,
                     response,
                 } => {
-                    shown.insert((condition.clone(), *query), (*task_s, *difficulty, *response));
+                    shown.insert(
+                        (condition.clone(), *query),
+                        (*task_s, *difficulty, *response),
+                    );
                 }
                 Event::SurveySubmitted {
                     condition,
@@ -66,20 +77,44 @@ pub fn export(dir: &Path) -> Result<Study> {
                     survey_time_s,
                 } => {
                     let Some((_, cond)) = design.condition(condition) else {
-                        return Err(hil_core::textdata::data_error(&path, i + 1, "condition", format!("`{condition}` is not in the design")));
+                        return Err(hil_core::textdata::data_error(
+                            &path,
+                            i + 1,
+                            "condition",
+                            format!("`{condition}` is not in the design"),
+                        ));
                     };
                     let (query_time_s, posed) = match (query, cond.queries) {
                         (Some(k), Some(f)) => {
-                            let Some(&(t, difficulty, response)) = shown.get(&(condition.clone(), *k)) else {
-                                return Err(hil_core::textdata::data_error(&path, i + 1, "query", format!("a survey after query {k}, which was never shown")));
+                            let Some(&(t, difficulty, response)) =
+                                shown.get(&(condition.clone(), *k))
+                            else {
+                                return Err(hil_core::textdata::data_error(
+                                    &path,
+                                    i + 1,
+                                    "query",
+                                    format!("a survey after query {k}, which was never shown"),
+                                ));
                             };
-                            (t, Some(PosedQuery { difficulty, response, interval_min: f.interval_min }))
+                            (
+                                t,
+                                Some(PosedQuery {
+                                    difficulty,
+                                    response,
+                                    interval_min: f.interval_min,
+                                }),
+                            )
                         }
                         (None, None) => (*task_s, None),
                         // End of a query condition: raw log only (see above).
                         (None, Some(_)) => continue,
                         (Some(_), None) => {
-                            return Err(hil_core::textdata::data_error(&path, i + 1, "query", "a query in a baseline condition"));
+                            return Err(hil_core::textdata::data_error(
+                                &path,
+                                i + 1,
+                                "query",
+                                "a query in a baseline condition",
+                            ));
                         }
                     };
                     records.push(StudyRecord {

@@ -138,7 +138,10 @@ pub fn read(path: &Path) -> Result<(Vec<Line>, usize)> {
                 path,
                 i + 1,
                 "seq",
-                format!("is {}, expected {i}: a line is missing or repeated", line.seq),
+                format!(
+                    "is {}, expected {i}: a line is missing or repeated",
+                    line.seq
+                ),
             ));
         }
         lines.push(line);
@@ -206,7 +209,8 @@ impl EventLog {
             unix_ms,
             event,
         };
-        let mut text = serde_json::to_string(&line).map_err(|e| HilError::serde("study event", e))?;
+        let mut text =
+            serde_json::to_string(&line).map_err(|e| HilError::serde("study event", e))?;
         text.push('\n');
         self.file
             .write_all(text.as_bytes())

@@ -81,7 +81,14 @@ pub fn cell_box(cell: usize) -> BoundingBox {
 
 /// Names a cell's place on the plate, as a hard question does.
 fn place_name(cell: usize) -> &'static str {
-    ["top left", "top middle", "top right", "bottom left", "bottom middle", "bottom right"][cell]
+    [
+        "top left",
+        "top middle",
+        "top right",
+        "bottom left",
+        "bottom middle",
+        "bottom right",
+    ][cell]
 }
 
 /// One food, drawn in a 100 × 100 box at the origin.

@@ -299,7 +299,9 @@ impl StudyServer {
     /// The URLs of participant `id`'s page.
     pub fn participant_urls(&self, id: &str) -> Option<Vec<String>> {
         let ps = self.shared.lock();
-        ps.values().find(|p| p.id == id).map(|p| self.links(&p.token))
+        ps.values()
+            .find(|p| p.id == id)
+            .map(|p| self.links(&p.token))
     }
 }
 
@@ -309,7 +311,14 @@ fn enrol(shared: &Shared, population: Population) -> Result<(String, String)> {
     let id = format!("p{:03}", number + 1);
     let token = random_token();
     let path = shared.dir.join("participants").join(format!("{id}.jsonl"));
-    let p = Participant::enrol(&shared.design, &path, id.clone(), population, number, token.clone())?;
+    let p = Participant::enrol(
+        &shared.design,
+        &path,
+        id.clone(),
+        population,
+        number,
+        token.clone(),
+    )?;
     ps.insert(token.clone(), p);
     Ok((id, token))
 }
@@ -403,7 +412,10 @@ fn researcher(shared: &Shared, req: &Request, rest: &str) -> Response {
                 Err(e) => return Response::json(400, &json!({"error": e.to_string()})),
             };
             match enrol(shared, parsed.population) {
-                Ok((id, token)) => Response::json(200, &json!({"participant": id, "link": format!("/{token}/")})),
+                Ok((id, token)) => Response::json(
+                    200,
+                    &json!({"participant": id, "link": format!("/{token}/")}),
+                ),
                 Err(e) => Response::json(500, &json!({"error": e.to_string()})),
             }
         }
@@ -429,10 +441,15 @@ struct Submission {
 
 fn submitted(r: std::result::Result<Submitted, Refused>) -> Response {
     match r {
-        Ok(s) => Response::json(200, &json!({"ok": true, "already_saved": s == Submitted::AlreadySaved})),
+        Ok(s) => Response::json(
+            200,
+            &json!({"ok": true, "already_saved": s == Submitted::AlreadySaved}),
+        ),
         Err(Refused::NotOpen(w)) => Response::json(409, &json!({"error": w})),
         Err(Refused::Invalid(w)) => Response::json(422, &json!({"error": w})),
-        Err(Refused::Storage(w)) => Response::json(500, &json!({"error": format!("not saved: {w}")})),
+        Err(Refused::Storage(w)) => {
+            Response::json(500, &json!({"error": format!("not saved: {w}")}))
+        }
     }
 }
 
@@ -460,7 +477,8 @@ fn participant(shared: &Shared, req: &Request, token: &str, rest: &str) -> Respo
             };
             let mut ps = shared.lock();
             let p = ps.get_mut(token).expect("checked");
-            let missing = |f: &str| Response::json(400, &json!({"error": format!("`{f}` is missing")}));
+            let missing =
+                |f: &str| Response::json(400, &json!({"error": format!("`{f}` is missing")}));
             let r = match rest {
                 "api/start" => p.start(design, &s.condition, now),
                 "api/answer" => {
@@ -468,12 +486,17 @@ fn participant(shared: &Shared, req: &Request, token: &str, rest: &str) -> Respo
                         return missing("query/answer");
                     };
                     if matches!(a, Answer::TimedOut | Answer::Action { .. }) {
-                        return Response::json(422, &json!({"error": "not an answer to a study query"}));
+                        return Response::json(
+                            422,
+                            &json!({"error": "not an answer to a study query"}),
+                        );
                     }
                     p.answer(design, &s.condition, k, a, now)
                 }
                 "api/survey" => {
-                    let Some(tlx) = s.tlx else { return missing("tlx") };
+                    let Some(tlx) = s.tlx else {
+                        return missing("tlx");
+                    };
                     p.survey(design, &s.condition, s.query, tlx, now)
                 }
                 _ => {

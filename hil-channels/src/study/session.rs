@@ -169,13 +169,21 @@ impl Participant {
             ..
         }) = lines.first().cloned()
         else {
-            return Err(line_error(&log, 0, "the first line must be `enrolled`".into()));
+            return Err(line_error(
+                &log,
+                0,
+                "the first line must be `enrolled`".into(),
+            ));
         };
         let order = order
             .iter()
             .map(|id| {
                 design.condition(id).map(|(i, _)| i).ok_or_else(|| {
-                    line_error(&log, 0, format!("condition `{id}` is not in this study's design"))
+                    line_error(
+                        &log,
+                        0,
+                        format!("condition `{id}` is not in this study's design"),
+                    )
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -360,7 +368,8 @@ impl Participant {
                 let times = design.query_times_s(c);
                 match self.last_tick {
                     Some(t) if now.duration_since(t) <= away => {
-                        let mut task = self.progress.task_s + now.duration_since(t).as_secs_f64() * scale;
+                        let mut task =
+                            self.progress.task_s + now.duration_since(t).as_secs_f64() * scale;
                         if self.progress.surveyed == times.len() && query.is_none() {
                             // No query left: the condition ends on time.
                             task = task.min(design.duration_s().max(self.progress.task_s));
@@ -443,7 +452,12 @@ impl Participant {
     }
 
     /// Starts the condition `condition` (the current one).
-    pub fn start(&mut self, design: &Design, condition: &str, now: Instant) -> std::result::Result<Submitted, Refused> {
+    pub fn start(
+        &mut self,
+        design: &Design,
+        condition: &str,
+        now: Instant,
+    ) -> std::result::Result<Submitted, Refused> {
         if self.is_past(design, condition, self.progress.started) == Some(true) {
             return Ok(Submitted::AlreadySaved);
         }
@@ -517,8 +531,14 @@ impl Participant {
         if self.phase(design) != (Phase::Survey { query }) {
             return Err(Refused::NotOpen("this survey is not open".into()));
         }
-        let tlx = TlxAnswers::new(tlx.mental, tlx.temporal, tlx.performance, tlx.effort, tlx.frustration)
-            .map_err(|e| Refused::Invalid(e.to_string()))?;
+        let tlx = TlxAnswers::new(
+            tlx.mental,
+            tlx.temporal,
+            tlx.performance,
+            tlx.effort,
+            tlx.frustration,
+        )
+        .map_err(|e| Refused::Invalid(e.to_string()))?;
         let survey_time_s = self
             .survey_shown_at
             .map_or(0.0, |t| now.duration_since(t).as_secs_f64());
@@ -547,11 +567,14 @@ impl Participant {
         answer: String,
         materials: &super::server::Materials,
     ) -> std::result::Result<Submitted, Refused> {
-        if self.is_past(design, condition, index < self.progress.distraction_answers) == Some(true) {
+        if self.is_past(design, condition, index < self.progress.distraction_answers) == Some(true)
+        {
             return Ok(Submitted::AlreadySaved);
         }
         if !matches!(self.phase(design), Phase::Task { .. }) {
-            return Err(Refused::NotOpen("the distraction task is not running".into()));
+            return Err(Refused::NotOpen(
+                "the distraction task is not running".into(),
+            ));
         }
         if answer.chars().count() > 2000 {
             return Err(Refused::Invalid("at most 2000 characters".into()));
@@ -564,7 +587,9 @@ impl Participant {
             }
             hil_core::Distraction::Hard => None,
             hil_core::Distraction::None => {
-                return Err(Refused::NotOpen("this condition has no distraction task".into()));
+                return Err(Refused::NotOpen(
+                    "this condition has no distraction task".into(),
+                ));
             }
         };
         self.record(
@@ -598,9 +623,7 @@ impl Participant {
                 let n = materials::revealed_words(p.task_s, materials.words_per_min);
                 let words = &materials.passage;
                 let from = n.saturating_sub(12);
-                let shown: Vec<&str> = (from..n)
-                    .map(|i| words[i % words.len()].as_str())
-                    .collect();
+                let shown: Vec<&str> = (from..n).map(|i| words[i % words.len()].as_str()).collect();
                 json!({"type": "transcription", "index": p.distraction_answers, "words": shown})
             }
         };
@@ -637,7 +660,7 @@ impl Participant {
                 "pictures": (0..q.pictures.len())
                     .map(|i| format!("image/{}/{k}/{i}", cond.id))
                     .collect::<Vec<_>>(),
-                "alt": q.pictures.iter().map(|pic| materials::describe(pic)).collect::<Vec<_>>(),
+                "alt": q.pictures.iter().map(materials::describe).collect::<Vec<_>>(),
             });
         }
         if let Phase::Survey { query } = phase {
@@ -661,7 +684,9 @@ fn check_answer(
             if options.contains(label) {
                 Ok((Some(label == correct), None))
             } else {
-                Err(Refused::Invalid(format!("`{label}` is not one of the choices")))
+                Err(Refused::Invalid(format!(
+                    "`{label}` is not one of the choices"
+                )))
             }
         }
         (Expected::Box { truth }, Answer::BoundingBox { bbox }) => {
@@ -673,17 +698,23 @@ fn check_answer(
             if ok {
                 Ok((None, Some(materials::iou(truth, bbox))))
             } else {
-                Err(Refused::Invalid("a box needs 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1".into()))
+                Err(Refused::Invalid(
+                    "a box needs 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1".into(),
+                ))
             }
         }
         (Expected::Text, Answer::Text { text }) => {
             if text.trim().is_empty() || text.chars().count() > 2000 {
-                Err(Refused::Invalid("the answer must be 1 to 2000 characters".into()))
+                Err(Refused::Invalid(
+                    "the answer must be 1 to 2000 characters".into(),
+                ))
             } else {
                 Ok((None, None))
             }
         }
-        _ => Err(Refused::Invalid("this kind of answer does not fit the question".into())),
+        _ => Err(Refused::Invalid(
+            "this kind of answer does not fit the question".into(),
+        )),
     }
 }
 

@@ -544,13 +544,19 @@ pub(crate) fn refuse_foreign_post(req: &Request) -> Option<HttpResponse> {
     let host = req.header("host").unwrap_or("");
     match req.header("origin") {
         Some(o) if o.eq_ignore_ascii_case(&format!("http://{host}")) => {}
-        Some(_) => return Some(forbidden("answers are accepted only from the page's own origin")),
+        Some(_) => {
+            return Some(forbidden(
+                "answers are accepted only from the page's own origin",
+            ));
+        }
         None => return Some(forbidden("answers need an Origin header")),
     }
     if let Some(site) = req.header("sec-fetch-site")
         && site != "same-origin"
     {
-        return Some(forbidden("answers are accepted only from the page's own origin"));
+        return Some(forbidden(
+            "answers are accepted only from the page's own origin",
+        ));
     }
     let is_json = req.header("content-type").is_some_and(|c| {
         c.split(';')
@@ -560,7 +566,10 @@ pub(crate) fn refuse_foreign_post(req: &Request) -> Option<HttpResponse> {
             .eq_ignore_ascii_case("application/json")
     });
     if !is_json {
-        return Some(HttpResponse::text(415, "the answer must be sent as application/json"));
+        return Some(HttpResponse::text(
+            415,
+            "the answer must be sent as application/json",
+        ));
     }
     None
 }

@@ -283,4 +283,3 @@ pub fn contrast(a: &str, b: &str) -> f64 {
     let (la, lb) = (lum(a), lum(b));
     (la.max(lb) + 0.05) / (la.min(lb) + 0.05)
 }
-

@@ -2,9 +2,10 @@
 //! Chromium, by keyboard only: a baseline (addition task) and two query
 //! conditions (easy and hard queries, transcription task) with the time
 //! scale at 60 (a study minute lasts a second). They answer every query
-//! type and every survey; the live page passes the accessibility checks;
-//! the export passes the study loader, has the expected pairs and fits a
-//! model.
+//! type and every survey, start the last part by single-switch scanning,
+//! and midway close the page and open their link again. The live page
+//! passes the accessibility checks; the export passes the study loader,
+//! has the expected pairs and fits a model.
 
 mod browser_support;
 
@@ -135,6 +136,7 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
     b.goto(&urls[0]);
     let mut seen = std::collections::BTreeSet::new();
     let mut surveys = 0;
+    let mut intros = 0;
     let mut audited = std::collections::BTreeSet::new();
     let deadline = Instant::now() + Duration::from_secs(300);
     loop {
@@ -162,6 +164,10 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
             while page_state(&b)["intro"] == json!(true) && Instant::now() < until {
                 std::thread::sleep(Duration::from_millis(30));
             }
+            assert_eq!(page_state(&b)["intro"], json!(false), "the part started");
+            if intros == 3 {
+                b.script("document.getElementById('scan-toggle').click();");
+            }
         } else if s["survey"] == json!(true) {
             check("survey");
             let legend = s["first_legend"].as_str().unwrap();
@@ -185,6 +191,13 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
             assert!(wait_focus(&b, &["survey-send"]));
             b.keys(&[ENTER]);
             surveys += 1;
+            if surveys == 2 {
+                // The participant closes the page mid-condition and opens
+                // the link again: they continue where they were.
+                b.goto("about:blank");
+                std::thread::sleep(Duration::from_millis(500));
+                b.goto(&urls[0]);
+            }
             // Wait for the survey to go.
             let until = Instant::now() + Duration::from_secs(10);
             while page_state(&b)["survey"] == json!(true) && Instant::now() < until {

@@ -212,10 +212,20 @@ impl EventLog {
         let mut text =
             serde_json::to_string(&line).map_err(|e| HilError::serde("study event", e))?;
         text.push('\n');
-        self.file
+        let len = self
+            .file
+            .metadata()
+            .map_err(|e| HilError::io("reading", &self.path, e))?
+            .len();
+        if let Err(e) = self
+            .file
             .write_all(text.as_bytes())
             .and_then(|()| self.file.sync_data())
-            .map_err(|e| HilError::io("appending to", &self.path, e))?;
+        {
+            // Take back a part-written line, so the next one starts clean.
+            let _ = self.file.set_len(len);
+            return Err(HilError::io("appending to", &self.path, e));
+        }
         self.next_seq += 1;
         Ok(line)
     }

@@ -154,12 +154,21 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
             break;
         } else if s["intro"] == json!(true) {
             check("intro");
-            assert!(
-                wait_focus(&b, &["start"]),
-                "focus is on Start: {}",
-                page_state(&b)
-            );
-            b.keys(&[ENTER]);
+            intros += 1;
+            if intros == 3 {
+                // Single-switch scanning: the highlight comes to Start by
+                // itself; one press of the switch (Space) starts.
+                b.script("document.getElementById('scan-speed').value = '1000'; document.getElementById('scan-toggle').click();");
+                b.find("#start.scan-focus");
+                b.keys(&[SPACE]);
+            } else {
+                assert!(
+                    wait_focus(&b, &["start"]),
+                    "focus is on Start: {}",
+                    page_state(&b)
+                );
+                b.keys(&[ENTER]);
+            }
             let until = Instant::now() + Duration::from_secs(10);
             while page_state(&b)["intro"] == json!(true) && Instant::now() < until {
                 std::thread::sleep(Duration::from_millis(30));

@@ -304,7 +304,7 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
         "--population",
         "d12",
         "--model",
-        "granger_n",
+        "granger_rn",
         "--history",
         "1",
         "--out",

@@ -25,7 +25,7 @@ use serde_json::{Value, json};
 use super::config::{DesignConfig, StudyConfig};
 use super::design::Design;
 use super::materials;
-use super::session::{Participant, Refused, Submitted};
+use super::session::{Participant, Phase, Refused, Submitted};
 use crate::web::http::{Limits, Request, Response, Server, Service};
 use crate::web::{
     PAGE_CSS, forbidden, host_allowed_in, refuse_foreign_post, same_token, split_token, urls,
@@ -336,7 +336,14 @@ fn progress(shared: &Shared) -> Value {
                 "conditions_done": pos,
                 "conditions": of,
                 "surveys": surveys,
-                "phase": format!("{:?}", p.phase(&shared.design)),
+                "phase": match p.phase(&shared.design) {
+                    Phase::Intro => "before a part".to_string(),
+                    Phase::Task { query: None } => "working".to_string(),
+                    Phase::Task { query: Some(k) } => format!("answering query {}", k + 1),
+                    Phase::Survey { query: Some(k) } => format!("survey after query {}", k + 1),
+                    Phase::Survey { query: None } => "end-of-part survey".to_string(),
+                    Phase::Done => "finished".to_string(),
+                },
                 "seen_s_ago": p.last_seen().map(|d| d.as_secs_f64()),
                 "link": format!("/{}/", p.token),
             })
@@ -531,8 +538,7 @@ fn picture(shared: &Shared, token: &str, rest: &str) -> Response {
     let Some((open_k, _)) = p.open_query(design) else {
         return Response::text(404, "no picture");
     };
-    let current = p.order.get(p.counts().1).copied();
-    if current != Some(c) || open_k != k || condition.queries.is_none() {
+    if p.current() != Some(c) || open_k != k || condition.queries.is_none() {
         return Response::text(404, "no picture");
     }
     let q = p.query_at(design, c, k);

@@ -195,17 +195,15 @@ impl Participant {
         Ok(p)
     }
 
-    fn current(&self, design: &Design) -> Option<usize> {
-        let _ = design;
+    /// The design index of the condition in progress (`None` when done).
+    pub fn current(&self) -> Option<usize> {
         self.order.get(self.progress.pos).copied()
     }
 
     /// Updates the progress with a logged event; the error says why the
     /// event does not fit.
     fn apply(&mut self, design: &Design, event: &Event) -> std::result::Result<(), String> {
-        let current = self
-            .current(design)
-            .map(|i| design.conditions()[i].id.as_str());
+        let current = self.current().map(|i| design.conditions()[i].id.as_str());
         let check = |c: &str| {
             if Some(c) == current {
                 Ok(())
@@ -319,7 +317,7 @@ impl Participant {
     /// Where the participant is now.
     pub fn phase(&self, design: &Design) -> Phase {
         let p = &self.progress;
-        let Some(c) = self.current(design) else {
+        let Some(c) = self.current() else {
             return Phase::Done;
         };
         if !p.started {
@@ -359,7 +357,7 @@ impl Participant {
     /// on every request from the participant's page.
     pub fn tick(&mut self, design: &Design, now: Instant, away: Duration) -> Result<()> {
         self.last_seen = Some(now);
-        let Some(c) = self.current(design) else {
+        let Some(c) = self.current() else {
             return Ok(());
         };
         let scale = design.config().time_scale;
@@ -429,7 +427,7 @@ impl Participant {
         let Phase::Task { query: Some(k) } = self.phase(design) else {
             return None;
         };
-        Some((k, self.query_at(design, self.current(design)?, k)))
+        Some((k, self.query_at(design, self.current()?, k)))
     }
 
     /// The query `k` of condition `c` for this participant.
@@ -579,7 +577,7 @@ impl Participant {
         if answer.chars().count() > 2000 {
             return Err(Refused::Invalid("at most 2000 characters".into()));
         }
-        let c = self.current(design).expect("in a condition");
+        let c = self.current().expect("in a condition");
         let correct = match design.conditions()[c].distraction {
             hil_core::Distraction::Easy => {
                 let (a, b) = materials.addition(design, self.number, c, index);
@@ -608,7 +606,7 @@ impl Participant {
     /// What the participant's page shows now.
     pub fn view(&self, design: &Design, materials: &super::server::Materials) -> Value {
         let phase = self.phase(design);
-        let Some(c) = self.current(design) else {
+        let Some(c) = self.current() else {
             return json!({"phase": "done", "participant": self.id});
         };
         let cond = &design.conditions()[c];

@@ -74,6 +74,149 @@ struct Progress {
     surveys_total: usize,
 }
 
+impl Progress {
+    /// Applies a logged event for a participant taking conditions in
+    /// `order`; the error says why the event does not fit.
+    fn apply(
+        &mut self,
+        order: &[usize],
+        design: &Design,
+        event: &Event,
+    ) -> std::result::Result<(), String> {
+        let current = order
+            .get(self.pos)
+            .map(|&i| design.conditions()[i].id.as_str());
+        let check = |c: &str| {
+            if Some(c) == current {
+                Ok(())
+            } else {
+                Err(format!(
+                    "is about condition `{c}`, but the participant is at {current:?}"
+                ))
+            }
+        };
+        let p = self;
+        match event {
+            Event::Enrolled { .. } => return Err("a second `enrolled` line".into()),
+            Event::ConditionStarted { condition } => {
+                check(condition)?;
+                p.started = true;
+                p.task_s = 0.0;
+            }
+            Event::QueryShown {
+                condition,
+                query,
+                task_s,
+                ..
+            } => {
+                check(condition)?;
+                if *query != p.shown {
+                    return Err(format!("shows query {query}, expected {}", p.shown));
+                }
+                p.shown += 1;
+                p.task_s = *task_s;
+            }
+            Event::QueryAnswered {
+                condition,
+                query,
+                task_s,
+                ..
+            } => {
+                check(condition)?;
+                if *query != p.answered || p.answered >= p.shown {
+                    return Err(format!("answers query {query}, which is not open"));
+                }
+                p.answered += 1;
+                p.task_s = *task_s;
+            }
+            Event::SurveySubmitted {
+                condition,
+                query,
+                task_s,
+                ..
+            } => {
+                check(condition)?;
+                p.surveys_total += 1;
+                match query {
+                    Some(k) => {
+                        if *k != p.surveyed || p.surveyed >= p.answered {
+                            return Err(format!("a survey after query {k}, which is not due"));
+                        }
+                        p.surveyed += 1;
+                        p.task_s = *task_s;
+                    }
+                    None => {
+                        let total = p.surveys_total;
+                        *p = Progress {
+                            pos: p.pos + 1,
+                            surveys_total: total,
+                            ..Progress::default()
+                        };
+                    }
+                }
+            }
+            Event::DistractionAnswered {
+                condition,
+                task_s,
+                index,
+                ..
+            } => {
+                check(condition)?;
+                if *index != p.distraction_answers {
+                    return Err(format!(
+                        "distraction answer {index}, expected {}",
+                        p.distraction_answers
+                    ));
+                }
+                p.distraction_answers += 1;
+                p.task_s = p.task_s.max(*task_s);
+            }
+            Event::Resumed { task_s, .. } => {
+                if p.started {
+                    p.task_s = *task_s;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Surveys submitted and conditions completed, of the participant log
+/// `lines` (read-only: for `hil study status` while a server may write).
+pub fn tally(
+    design: &Design,
+    path: &std::path::Path,
+    lines: &[Line],
+) -> Result<(usize, usize, usize)> {
+    let Some(Event::Enrolled { order, .. }) = lines.first().map(|l| &l.event) else {
+        return Err(hil_core::textdata::data_error(
+            path,
+            1,
+            "event",
+            "the first line must be `enrolled`",
+        ));
+    };
+    let order = order
+        .iter()
+        .map(|id| {
+            design.condition(id).map(|(i, _)| i).ok_or_else(|| {
+                hil_core::textdata::data_error(
+                    path,
+                    1,
+                    "order",
+                    format!("condition `{id}` is not in the design"),
+                )
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut p = Progress::default();
+    for l in &lines[1..] {
+        p.apply(&order, design, &l.event)
+            .map_err(|why| hil_core::textdata::data_error(path, l.seq + 1, "event", why))?;
+    }
+    Ok((p.surveys_total, p.pos.min(order.len()), order.len()))
+}
+
 /// A participant being served.
 #[derive(Debug)]
 pub struct Participant {
@@ -203,99 +346,7 @@ impl Participant {
     /// Updates the progress with a logged event; the error says why the
     /// event does not fit.
     fn apply(&mut self, design: &Design, event: &Event) -> std::result::Result<(), String> {
-        let current = self.current().map(|i| design.conditions()[i].id.as_str());
-        let check = |c: &str| {
-            if Some(c) == current {
-                Ok(())
-            } else {
-                Err(format!(
-                    "is about condition `{c}`, but the participant is at {current:?}"
-                ))
-            }
-        };
-        let p = &mut self.progress;
-        match event {
-            Event::Enrolled { .. } => return Err("a second `enrolled` line".into()),
-            Event::ConditionStarted { condition } => {
-                check(condition)?;
-                p.started = true;
-                p.task_s = 0.0;
-            }
-            Event::QueryShown {
-                condition,
-                query,
-                task_s,
-                ..
-            } => {
-                check(condition)?;
-                if *query != p.shown {
-                    return Err(format!("shows query {query}, expected {}", p.shown));
-                }
-                p.shown += 1;
-                p.task_s = *task_s;
-            }
-            Event::QueryAnswered {
-                condition,
-                query,
-                task_s,
-                ..
-            } => {
-                check(condition)?;
-                if *query != p.answered || p.answered >= p.shown {
-                    return Err(format!("answers query {query}, which is not open"));
-                }
-                p.answered += 1;
-                p.task_s = *task_s;
-            }
-            Event::SurveySubmitted {
-                condition,
-                query,
-                task_s,
-                ..
-            } => {
-                check(condition)?;
-                p.surveys_total += 1;
-                match query {
-                    Some(k) => {
-                        if *k != p.surveyed || p.surveyed >= p.answered {
-                            return Err(format!("a survey after query {k}, which is not due"));
-                        }
-                        p.surveyed += 1;
-                        p.task_s = *task_s;
-                    }
-                    None => {
-                        let total = p.surveys_total;
-                        *p = Progress {
-                            pos: p.pos + 1,
-                            surveys_total: total,
-                            ..Progress::default()
-                        };
-                    }
-                }
-            }
-            Event::DistractionAnswered {
-                condition,
-                task_s,
-                index,
-                ..
-            } => {
-                check(condition)?;
-                if *index != p.distraction_answers {
-                    return Err(format!(
-                        "distraction answer {index}, expected {}",
-                        p.distraction_answers
-                    ));
-                }
-                p.distraction_answers += 1;
-                p.task_s = p.task_s.max(*task_s);
-            }
-            Event::Resumed { task_s, .. } => {
-                if p.started {
-                    p.task_s = *task_s;
-                }
-            }
-        }
-        Ok(())
+        self.progress.apply(&self.order, design, event)
     }
 
     /// Logs `event` and applies it.

@@ -5,8 +5,9 @@ use std::net::{IpAddr, Ipv4Addr};
 use std::path::PathBuf;
 
 use hil_channels::study::log::{Event, read};
-use hil_channels::study::server::participant_logs;
-use hil_channels::study::{StudyConfig, StudyServer, export};
+use hil_channels::study::server::{participant_logs, stored_design};
+use hil_channels::study::session::tally;
+use hil_channels::study::{Design, StudyConfig, StudyServer, export};
 use hil_core::Result;
 use hil_workload::study::Population;
 
@@ -110,29 +111,30 @@ pub fn run(args: StudyArgs) -> Result<()> {
             Ok(())
         }
         StudyCommand::Status { data } => {
+            let design = stored_design(&data)?.ok_or_else(|| {
+                hil_core::HilError::invalid_input(
+                    "data folder",
+                    format!(
+                        "{} has no design.json: not a study data folder",
+                        data.display()
+                    ),
+                )
+            })?;
+            let design = Design::new(design)?;
             for path in participant_logs(&data)? {
                 let (lines, _) = read(&path)?;
+                let (surveys, done, of) = tally(&design, &path, &lines)?;
                 let Some(Event::Enrolled {
                     participant,
                     population,
-                    order,
                     ..
                 }) = lines.first().map(|l| &l.event)
                 else {
                     continue;
                 };
-                let mut surveys = 0;
-                let mut ended = 0;
-                for l in &lines {
-                    if let Event::SurveySubmitted { query, .. } = &l.event {
-                        surveys += 1;
-                        ended += usize::from(query.is_none());
-                    }
-                }
                 println!(
-                    "{participant} {}: {ended}/{} conditions, {surveys} surveys",
-                    population.as_str(),
-                    order.len()
+                    "{participant} {}: {done}/{of} conditions, {surveys} surveys",
+                    population.as_str()
                 );
             }
             Ok(())

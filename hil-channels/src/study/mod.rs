@@ -11,7 +11,7 @@
 //!   token, a researcher's progress page; every answer is appended to the
 //!   participant's log and fsync'ed before the page is told it is saved,
 //!   and a restarted server or reopened page resumes where it was.
-//! - [`export`]: the logs as the study CSV, validated by the loader.
+//! - [`export()`]: the logs as the study CSV, validated by the loader.
 //! - [`materials`]: the drawn food pictures, the queries built on them,
 //!   the addition task and the transcription passage.
 //! - [`tlx`]: the modified NASA-TLX questions, worded by population.

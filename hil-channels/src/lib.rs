@@ -11,6 +11,9 @@
 //! - [`WebChannel`]: a page served on 127.0.0.1 for the person being fed,
 //!   on a phone or tablet, by touch, keyboard or single switch
 //!   (`type = "web"`).
+//! - [`study`]: the paper's querying-workload study served on the same
+//!   server (`hil study serve`), with fsync'ed, resumable participant logs
+//!   and an export to the study CSV that `hil_workload` fits models from.
 //!
 //! To try the channels without a robot, the demo components live with
 //! their traits: `hil_envs::demo_plate` (`demo_plate`),
@@ -22,6 +25,7 @@
 
 pub mod present;
 pub mod simulated;
+pub mod study;
 pub mod terminal;
 pub mod web;
 

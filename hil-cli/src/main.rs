@@ -34,6 +34,8 @@ enum Command {
     Bench(cmd::bench::BenchArgs),
     /// Workload study data and models: generate, select, fit, rollout, bundle.
     Workload(cmd::workload::WorkloadArgs),
+    /// The workload study in the browser: serve it, follow progress, export the CSV.
+    Study(cmd::study::StudyArgs),
     /// Inspect plugin libraries and check their types for conformance.
     Plugins(cmd::plugins::PluginsArgs),
 }
@@ -55,6 +57,7 @@ fn main() -> ExitCode {
         Command::Kinova(args) => cmd::kinova::kinova(args),
         Command::Bench(args) => cmd::bench::run(args),
         Command::Workload(args) => cmd::workload::run(args),
+        Command::Study(args) => cmd::study::run(args),
         Command::Plugins(args) => cmd::plugins::run(args),
     };
     match result {

@@ -21,7 +21,8 @@ use http::{Limits, Occupancy, Request, Response as HttpResponse, Server, Service
 
 const PAGE_HTML: &str = include_str!("page.html");
 const PAGE_JS: &str = include_str!("page.js");
-const PAGE_CSS: &str = include_str!("page.css");
+/// The page's style sheet; the study's pages share it.
+pub(crate) const PAGE_CSS: &str = include_str!("page.css");
 
 /// The default time a person has to answer before the policy acts alone.
 pub const DEFAULT_TIMEOUT_S: f64 = 120.0;
@@ -409,12 +410,12 @@ fn query_view(p: &Pending) -> Value {
     })
 }
 
-fn forbidden(why: &str) -> HttpResponse {
+pub(crate) fn forbidden(why: &str) -> HttpResponse {
     HttpResponse::text(403, format!("forbidden: {why}"))
 }
 
 /// Compares without revealing, by timing, how much of the token matched.
-fn same_token(a: &str, b: &str) -> bool {
+pub(crate) fn same_token(a: &str, b: &str) -> bool {
     a.len() == b.len()
         && a.bytes()
             .zip(b.bytes())
@@ -426,6 +427,11 @@ fn same_token(a: &str, b: &str) -> bool {
 /// or an allowed name, on our port. Refusing other names defeats DNS
 /// rebinding.
 fn host_allowed(shared: &Shared, port: u16, host: &str) -> bool {
+    host_allowed_in(&shared.allowed_hosts, port, host)
+}
+
+/// [`host_allowed`] for a list of allowed (lower-case) names.
+pub(crate) fn host_allowed_in(allowed_hosts: &[String], port: u16, host: &str) -> bool {
     let host = host.to_ascii_lowercase();
     let (name, host_port) = match host.rsplit_once(':') {
         Some((n, p)) if !n.ends_with(']') || host.starts_with('[') => match p.parse::<u16>() {
@@ -440,7 +446,7 @@ fn host_allowed(shared: &Shared, port: u16, host: &str) -> bool {
     let bare = name.trim_start_matches('[').trim_end_matches(']');
     bare.parse::<IpAddr>().is_ok()
         || bare == "localhost"
-        || shared.allowed_hosts.iter().any(|h| *h == bare)
+        || allowed_hosts.iter().any(|h| *h == bare)
 }
 
 #[derive(Deserialize)]
@@ -464,7 +470,7 @@ impl Service for Page {
 }
 
 /// Splits `/TOKEN/rest` into the token and the rest.
-fn split_token(path: &str) -> (&str, &str) {
+pub(crate) fn split_token(path: &str) -> (&str, &str) {
     let mut segments = path.trim_start_matches('/').splitn(2, '/');
     (segments.next().unwrap_or(""), segments.next().unwrap_or(""))
 }
@@ -522,20 +528,26 @@ fn handle(shared: &Shared, req: &Request) -> HttpResponse {
     }
 }
 
-fn post_answer(shared: &Shared, req: &Request) -> HttpResponse {
-    // Only the page itself may answer: browsers always send Origin on a
-    // POST, and a JSON body cannot be sent cross-origin without a CORS
-    // preflight, which this server never grants.
+/// Refuses a POST that does not come from the page itself: browsers always
+/// send Origin on a POST, and a JSON body cannot be sent cross-origin
+/// without a CORS preflight, which this server never grants.
+pub(crate) fn refuse_foreign_post(req: &Request) -> Option<HttpResponse> {
     let host = req.header("host").unwrap_or("");
     match req.header("origin") {
         Some(o) if o.eq_ignore_ascii_case(&format!("http://{host}")) => {}
-        Some(_) => return forbidden("answers are accepted only from the page's own origin"),
-        None => return forbidden("answers need an Origin header"),
+        Some(_) => {
+            return Some(forbidden(
+                "answers are accepted only from the page's own origin",
+            ));
+        }
+        None => return Some(forbidden("answers need an Origin header")),
     }
     if let Some(site) = req.header("sec-fetch-site")
         && site != "same-origin"
     {
-        return forbidden("answers are accepted only from the page's own origin");
+        return Some(forbidden(
+            "answers are accepted only from the page's own origin",
+        ));
     }
     let is_json = req.header("content-type").is_some_and(|c| {
         c.split(';')
@@ -545,7 +557,17 @@ fn post_answer(shared: &Shared, req: &Request) -> HttpResponse {
             .eq_ignore_ascii_case("application/json")
     });
     if !is_json {
-        return HttpResponse::text(415, "the answer must be sent as application/json");
+        return Some(HttpResponse::text(
+            415,
+            "the answer must be sent as application/json",
+        ));
+    }
+    None
+}
+
+fn post_answer(shared: &Shared, req: &Request) -> HttpResponse {
+    if let Some(refused) = refuse_foreign_post(req) {
+        return refused;
     }
     let parsed: AnswerRequest = match serde_json::from_slice(&req.body) {
         Ok(a) => a,

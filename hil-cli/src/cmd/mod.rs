@@ -6,6 +6,7 @@ pub mod kinova;
 pub mod plugins;
 pub mod reproduce;
 pub mod run;
+pub mod study;
 pub mod workload;
 
 /// A rayon pool of `threads` workers (default: all cores) and its size.

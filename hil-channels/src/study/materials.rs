@@ -71,12 +71,12 @@ const H: f64 = 400.0;
 pub fn cell_box(cell: usize) -> BoundingBox {
     let (c, r) = ((cell % COLS) as f64, (cell / COLS) as f64);
     let (cw, ch) = (1.0 / COLS as f64, 1.0 / ROWS as f64);
-    BoundingBox {
-        x0: (c + 0.15) * cw,
-        y0: (r + 0.15) * ch,
-        x1: (c + 0.85) * cw,
-        y1: (r + 0.85) * ch,
-    }
+    BoundingBox::new(
+        (c + 0.15) * cw,
+        (r + 0.15) * ch,
+        (c + 0.85) * cw,
+        (r + 0.85) * ch,
+    )
 }
 
 /// Names a cell's place on the plate, as a hard question does.

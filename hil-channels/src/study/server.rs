@@ -243,10 +243,7 @@ impl StudyServer {
             participants: Mutex::new(participants),
         });
         let bind = SocketAddr::new(config.server.bind, config.server.port);
-        let channel_error = |why: String| HilError::Channel {
-            channel: "study".into(),
-            why,
-        };
+        let channel_error = |why: String| HilError::channel("study", why);
         let server = Server::start(bind, Arc::new(Pages(shared.clone())), Limits::default())
             .map_err(|e| channel_error(format!("cannot listen on {bind}: {e}")))?;
         let addr = server.addr();

@@ -65,17 +65,25 @@ fn channel_runs(d: Option<ChannelDefect>, only: Option<Check>) -> Run {
 /// The suite, and the broken property alone, fail with the defect's check.
 fn assert_caught(what: &str, breaks: Check, run: impl Fn(Option<Check>) -> Run) {
     let e = run(None).expect_err(what);
-    assert_eq!(e.check, breaks, "{what}: the whole suite failed another check: {e}");
+    assert_eq!(
+        e.check, breaks,
+        "{what}: the whole suite failed another check: {e}"
+    );
     if !breaks.is_prerequisite() {
         let e = run(Some(breaks)).expect_err(what);
-        assert_eq!(e.check, breaks, "{what}: the property alone failed another check: {e}");
+        assert_eq!(
+            e.check, breaks,
+            "{what}: the property alone failed another check: {e}"
+        );
     }
 }
 
 #[test]
 fn every_broken_policy_fails_its_check() {
     for &d in PolicyDefect::ALL {
-        assert_caught(&format!("{d:?}"), d.breaks(), |only| policy_runs(Some(d), only));
+        assert_caught(&format!("{d:?}"), d.breaks(), |only| {
+            policy_runs(Some(d), only)
+        });
     }
 }
 
@@ -91,14 +99,18 @@ fn every_broken_environment_fails_its_check() {
 #[test]
 fn every_broken_workload_model_fails_its_check() {
     for &d in WorkloadDefect::ALL {
-        assert_caught(&format!("{d:?}"), d.breaks(), |only| workload_runs(Some(d), only));
+        assert_caught(&format!("{d:?}"), d.breaks(), |only| {
+            workload_runs(Some(d), only)
+        });
     }
 }
 
 #[test]
 fn every_broken_channel_fails_its_check() {
     for &d in ChannelDefect::ALL {
-        assert_caught(&format!("{d:?}"), d.breaks(), |only| channel_runs(Some(d), only));
+        assert_caught(&format!("{d:?}"), d.breaks(), |only| {
+            channel_runs(Some(d), only)
+        });
     }
 }
 
@@ -112,7 +124,10 @@ fn every_check_has_a_broken_implementation() {
         .chain(ChannelDefect::ALL.iter().map(|d| d.breaks()))
         .collect();
     let missing: Vec<&Check> = Check::ALL.iter().filter(|c| !covered.contains(c)).collect();
-    assert!(missing.is_empty(), "checks without a broken implementation: {missing:?}");
+    assert!(
+        missing.is_empty(),
+        "checks without a broken implementation: {missing:?}"
+    );
 }
 
 #[test]
@@ -125,7 +140,11 @@ fn the_unbroken_implementations_pass_every_property() {
     ];
     for (subject, run) in subjects {
         let report = run(None).unwrap_or_else(|e| panic!("{subject:?}: {e}"));
-        assert!(report.skipped.is_empty(), "{subject:?}: {:?}", report.skipped);
+        assert!(
+            report.skipped.is_empty(),
+            "{subject:?}: {:?}",
+            report.skipped
+        );
         for p in Check::properties(subject) {
             assert!(report.passed.contains(&p), "{subject:?}: {p} not exercised");
             assert_conforms(run(Some(p)), p);
@@ -174,10 +193,7 @@ fn a_generated_test_fails_naming_its_property() {
     );
     let panic = std::panic::catch_unwind(|| assert_conforms(r, Check::RejectsWrongDimension))
         .expect_err("the property fails");
-    let message = panic
-        .downcast_ref::<String>()
-        .cloned()
-        .unwrap_or_default();
+    let message = panic.downcast_ref::<String>().cloned().unwrap_or_default();
     assert!(
         message.starts_with("property `rejects wrong dimension` does not hold for `broken_policy`"),
         "{message}"

@@ -28,9 +28,9 @@ use crate::environment::CallOrder;
 use crate::plugin::{GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload};
 use crate::policy::{check_feedback, check_input};
 use crate::{
-    ActionSpace, ArmDiagnostics, ArmId, Context, Decision, DecisionInput, Diagnostics,
-    Environment, Feedback, HilError, Item, Outcome, Policy, Query, QueryChannel, QueryHistory,
-    QueryKind, Response, Result, Timestep, WorkloadModel,
+    ActionSpace, ArmDiagnostics, ArmId, Context, Decision, DecisionInput, Diagnostics, Environment,
+    Feedback, HilError, Item, Outcome, Policy, Query, QueryChannel, QueryHistory, QueryKind,
+    Response, Result, Timestep, WorkloadModel,
 };
 
 /// A process-wide counter: state no seed reaches, like `thread_rng` or the
@@ -174,7 +174,11 @@ defects! {
 pub fn policy(defect: Option<PolicyDefect>, opts: &CheckOptions) -> Result<Box<dyn Policy>> {
     use PolicyDefect as D;
     if defect == Some(D::FactoryFails) {
-        return Err(HilError::invalid_parameter("epsilon", -1, "must be in [0, 1]"));
+        return Err(HilError::invalid_parameter(
+            "epsilon",
+            -1,
+            "must be in [0, 1]",
+        ));
     }
     let extra = usize::from(defect == Some(D::IgnoresBuildContext));
     let p = EpsilonGreedy {
@@ -188,7 +192,11 @@ pub fn policy(defect: Option<PolicyDefect>, opts: &CheckOptions) -> Result<Box<d
         steps: 0,
     };
     if matches!(defect, Some(D::PanicsOnLongerContext | D::PanicsInSave)) {
-        Ok(Box::new(GuardedPolicy::new(Box::new(p), in_process(), "broken_policy")?))
+        Ok(Box::new(GuardedPolicy::new(
+            Box::new(p),
+            in_process(),
+            "broken_policy",
+        )?))
     } else {
         Ok(Box::new(p))
     }
@@ -470,7 +478,11 @@ impl Environment for TableEnv {
         } else {
             self.rng.random_range(-1.0..1.0)
         };
-        let mut x = vec![(i % TABLE.len()) as f64, noise, self.rng.random_range(-1.0..1.0)];
+        let mut x = vec![
+            (i % TABLE.len()) as f64,
+            noise,
+            self.rng.random_range(-1.0..1.0),
+        ];
         if self.is(EnvironmentDefect::LongerContexts) {
             x.push(0.0);
         }
@@ -572,11 +584,13 @@ impl WorkloadModel for Counting {
         let mut h = history.clone();
         h.push(t, kind)?;
         let wl = self.predict(wl0, &h, t)?;
-        Ok(if self.defect == Some(WorkloadDefect::WrongCounterfactual) {
-            wl + 0.05
-        } else {
-            wl
-        })
+        Ok(
+            if self.defect == Some(WorkloadDefect::WrongCounterfactual) {
+                wl + 0.05
+            } else {
+                wl
+            },
+        )
     }
 }
 

@@ -61,6 +61,10 @@ fn run(
     opts: &CheckOptions,
     only: Option<Check>,
 ) -> Result<ConformanceReport, ConformanceFailure> {
+    let make = &super::guarded(make, |o, lib| {
+        let name = o.name().to_string();
+        Ok(Box::new(crate::plugin::GuardedChannel::new(o, lib, &name)?) as Box<dyn QueryChannel>)
+    });
     let build_failure = |e: crate::HilError| ConformanceFailure {
         subject: "<query channel factory>".into(),
         check: Check::Build,
@@ -73,7 +77,8 @@ fn run(
     if c.wants(Check::SeededReplay) {
         let mut b = c.ok(Check::Build, make())?;
         let rb = answers(&mut c, b.as_mut(), opts)?;
-        let same = |x: &Response, y: &Response| x.answer == y.answer && x.expert_arm == y.expert_arm;
+        let same =
+            |x: &Response, y: &Response| x.answer == y.answer && x.expert_arm == y.expert_arm;
         let first = ra.iter().zip(&rb).position(|(x, y)| !same(x, y));
         c.check(Check::SeededReplay, first.is_none(), || {
             let i = first.unwrap_or(0);
@@ -139,7 +144,10 @@ fn answers(
         )?;
         if let crate::Answer::Action { arm } = r.answer {
             c.check(Check::AnswerConsistent, r.expert_arm == Some(arm), || {
-                format!("query {i}: answer {arm:?} but expert_arm {:?}", r.expert_arm)
+                format!(
+                    "query {i}: answer {arm:?} but expert_arm {:?}",
+                    r.expert_arm
+                )
             })?;
         }
         out.push(r);

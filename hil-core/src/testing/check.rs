@@ -169,13 +169,31 @@ impl Check {
         use Check::*;
         Some(match self {
             Build => return None,
-            PolicyShape | PolicyDecides | ArmInRange | FiniteDiagnostics | DiagnosticsCoverArms
-            | Determinism | RejectsWrongDimension | RejectsArmOutOfRange
-            | RejectionHasNoEffect | Checkpoint => Subject::Policy,
-            EnvironmentShape | EpisodeRuns | EpisodeHasItems | EpisodesEnd | CurrentItem
-            | ContextDimension | SuccessProbability | BestActionInRange | Replayable
-            | ExecuteRejectsArmOutOfRange | OutOfOrderCalls => Subject::Environment,
-            Predicts | EmptyHistory | FinitePrediction | DeterministicPrediction
+            PolicyShape
+            | PolicyDecides
+            | ArmInRange
+            | FiniteDiagnostics
+            | DiagnosticsCoverArms
+            | Determinism
+            | RejectsWrongDimension
+            | RejectsArmOutOfRange
+            | RejectionHasNoEffect
+            | Checkpoint => Subject::Policy,
+            EnvironmentShape
+            | EpisodeRuns
+            | EpisodeHasItems
+            | EpisodesEnd
+            | CurrentItem
+            | ContextDimension
+            | SuccessProbability
+            | BestActionInRange
+            | Replayable
+            | ExecuteRejectsArmOutOfRange
+            | OutOfOrderCalls => Subject::Environment,
+            Predicts
+            | EmptyHistory
+            | FinitePrediction
+            | DeterministicPrediction
             | Counterfactual => Subject::WorkloadModel,
             Answers | ExpertArmInRange | ResponseTime | AnswerConsistent | SeededReplay => {
                 Subject::QueryChannel
@@ -265,10 +283,10 @@ impl Check {
             EpisodeRuns => {
                 "a call in the documented order (reset, next_item, observe, execute) failed; follow hil_core::environment::CallOrder"
             }
-            EpisodeHasItems => "reset produced an episode with no items; give every episode at least one item",
-            EpisodesEnd => {
-                "next_item never returns None; end the episode after its last item"
+            EpisodeHasItems => {
+                "reset produced an episode with no items; give every episode at least one item"
             }
+            EpisodesEnd => "next_item never returns None; end the episode after its last item",
             CurrentItem => {
                 "current_item() is not the item next_item() returned; store the item when next_item returns it"
             }

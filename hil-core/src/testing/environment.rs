@@ -57,6 +57,13 @@ fn run(
     opts: &CheckOptions,
     only: Option<Check>,
 ) -> Result<ConformanceReport, ConformanceFailure> {
+    let make = &super::guarded(make, |o, lib| {
+        let name = o.name().to_string();
+        Ok(
+            Box::new(crate::plugin::GuardedEnvironment::new(o, lib, &name)?)
+                as Box<dyn Environment>,
+        )
+    });
     let build_failure = |e: HilError| ConformanceFailure {
         subject: "<environment factory>".into(),
         check: Check::Build,
@@ -225,7 +232,12 @@ fn run_episode(
                 Check::SuccessProbability,
                 out.success_probability
                     .is_none_or(|p| (0.0..=1.0).contains(&p)),
-                || format!("execute({arm:?}) reported success probability {:?}", out.success_probability),
+                || {
+                    format!(
+                        "execute({arm:?}) reported success probability {:?}",
+                        out.success_probability
+                    )
+                },
             )?;
             let success = out.success;
             steps.push((x, best, out));

@@ -15,10 +15,16 @@ use super::{Check, ConformanceFailure, ConformanceReport};
 #[track_caller]
 pub fn assert_conforms(result: Result<ConformanceReport, ConformanceFailure>, property: Check) {
     match result {
-        Err(f) => panic!("property `{property}` does not hold for `{}`: {f}", f.subject),
+        Err(f) => panic!(
+            "property `{property}` does not hold for `{}`: {f}",
+            f.subject
+        ),
         Ok(report) => {
             if let Some((_, why)) = report.skipped.iter().find(|(c, _)| *c == property) {
-                eprintln!("property `{property}` skipped for `{}`: {why}", report.subject);
+                eprintln!(
+                    "property `{property}` skipped for `{}`: {why}",
+                    report.subject
+                );
             } else if !report.passed.contains(&property) {
                 panic!(
                     "property `{property}` was never exercised for `{}` (passed: {})",

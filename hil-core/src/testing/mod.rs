@@ -177,6 +177,21 @@ impl Checker {
     }
 }
 
+/// Where the panic guard says an object under test came from.
+fn under_test() -> std::path::PathBuf {
+    std::path::PathBuf::from("<object under test>")
+}
+
+/// Runs `make`'s objects under the plugin panic guard (again, for a
+/// plugin's), so a panic in a method is reported as a failure of the check
+/// that called it instead of unwinding through the suite.
+pub(crate) fn guarded<T: ?Sized>(
+    make: &dyn Fn() -> crate::Result<Box<T>>,
+    wrap: impl Fn(Box<T>, std::path::PathBuf) -> crate::Result<Box<T>>,
+) -> impl Fn() -> crate::Result<Box<T>> {
+    move || wrap(make()?, under_test())
+}
+
 /// An error as a failure's detail: a guarded panic is named as one.
 fn describe_error(e: &HilError) -> String {
     match e {

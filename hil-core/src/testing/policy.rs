@@ -73,6 +73,10 @@ fn run(
     opts: &CheckOptions,
     only: Option<Check>,
 ) -> Result<ConformanceReport, ConformanceFailure> {
+    let make = &super::guarded(make, |o, lib| {
+        let name = o.name().to_string();
+        Ok(Box::new(crate::plugin::GuardedPolicy::new(o, lib, &name)?) as Box<dyn Policy>)
+    });
     opts.validate().map_err(|e| build_failure(&e))?;
     let first = make().map_err(|e| build_failure(&e))?;
     let mut c = Checker::new(first.name(), only);
@@ -117,7 +121,14 @@ fn run(
         a.seed(42);
         b.seed(42);
         let mut pair = Pair::new(a.as_mut(), b.as_mut());
-        pair.run(&mut c, opts, &mut rng, opts.steps(), Some(Check::Determinism), Check::PolicyDecides)?;
+        pair.run(
+            &mut c,
+            opts,
+            &mut rng,
+            opts.steps(),
+            Some(Check::Determinism),
+            Check::PolicyDecides,
+        )?;
     }
 
     // Bad input: refused with the right kind, and without side effects.
@@ -140,11 +151,17 @@ fn run(
             }
             for got in wrong {
                 let x = Context::new(vec![0.5; got]).expect("finite");
-                let is_mismatch = |e: &HilError| {
-                    matches!(e, HilError::DimensionMismatch { expected, got: g } if *expected == dim && *g == got)
-                };
-                let kind_name = format!("HilError::DimensionMismatch {{ expected: {dim}, got: {got} }}");
-                let r = p.decide(&decision_input(&x, t, item, 0, opts.workload(), &pair.ta.history));
+                let is_mismatch = |e: &HilError| matches!(e, HilError::DimensionMismatch { expected, got: g } if *expected == dim && *g == got);
+                let kind_name =
+                    format!("HilError::DimensionMismatch {{ expected: {dim}, got: {got} }}");
+                let r = p.decide(&decision_input(
+                    &x,
+                    t,
+                    item,
+                    0,
+                    opts.workload(),
+                    &pair.ta.history,
+                ));
                 c.refused(
                     kind,
                     &format!("decide with a context of dimension {got} (policy has {dim})"),
@@ -209,7 +226,15 @@ fn run(
         for _ in 0..half {
             let x = random_context(&mut rng, a.dim());
             let reward = f64::from(rng.random_bool(0.5));
-            drive(&mut c, a.as_mut(), &x, opts.workload(), &mut ta, reward, Check::PolicyDecides)?;
+            drive(
+                &mut c,
+                a.as_mut(),
+                &x,
+                opts.workload(),
+                &mut ta,
+                reward,
+                Check::PolicyDecides,
+            )?;
         }
         let state = c.ok(Check::Checkpoint, a.save())?;
         let mut r = build(&c)?;
@@ -221,7 +246,14 @@ fn run(
             tb: ta.clone(),
             ta,
         };
-        pair.run(&mut c, opts, &mut rng, half, Some(Check::Checkpoint), Check::Checkpoint)?;
+        pair.run(
+            &mut c,
+            opts,
+            &mut rng,
+            half,
+            Some(Check::Checkpoint),
+            Check::Checkpoint,
+        )?;
     }
     Ok(c.finish())
 }
@@ -292,7 +324,10 @@ impl<'p> Pair<'p> {
             let db = drive(c, self.b, &x, opts.workload(), &mut self.tb, reward, err)?;
             if let Some(check) = compare {
                 c.check(check, da == db, || {
-                    format!("same seed and inputs, different decisions at t = {}: {da:?} vs {db:?}", self.ta.t)
+                    format!(
+                        "same seed and inputs, different decisions at t = {}: {da:?} vs {db:?}",
+                        self.ta.t
+                    )
                 })?;
             }
         }
@@ -328,7 +363,10 @@ fn drive(
     } else {
         (s.item, s.attempt + 1)
     };
-    let d = c.ok(err, p.decide(&decision_input(x, t, item, attempt, model, &s.history)))?;
+    let d = c.ok(
+        err,
+        p.decide(&decision_input(x, t, item, attempt, model, &s.history)),
+    )?;
     let n = p.n_arms();
     let arm = match d.choice {
         Choice::Act { arm } => arm,
@@ -356,7 +394,9 @@ fn drive(
     ]
     .iter()
     .all(|v| v.is_none_or(f64::is_finite));
-    c.check(Check::FiniteDiagnostics, finite, || format!("at t = {t}: {diag:?}"))?;
+    c.check(Check::FiniteDiagnostics, finite, || {
+        format!("at t = {t}: {diag:?}")
+    })?;
     c.check(
         Check::DiagnosticsCoverArms,
         diag.arms.is_empty() || diag.arms.len() == n,

@@ -45,6 +45,8 @@ fn run(
     _opts: &CheckOptions,
     only: Option<Check>,
 ) -> Result<ConformanceReport, ConformanceFailure> {
+    let caught = Caught(model);
+    let model: &dyn WorkloadModel = &caught;
     let mut c = Checker::new(model.name(), only);
     let empty = crate::QueryHistory::new();
     if c.wants(Check::EmptyHistory) {
@@ -75,7 +77,12 @@ fn run(
             c.check(
                 Check::DeterministicPrediction,
                 p.to_bits() == q.to_bits(),
-                || format!("WL_0 = {wl0}, {} queries, t = {t}: {p} then {q}", history.len()),
+                || {
+                    format!(
+                        "WL_0 = {wl0}, {} queries, t = {t}: {p} then {q}",
+                        history.len()
+                    )
+                },
             )?;
             if !c.wants(Check::Counterfactual) {
                 continue;
@@ -118,4 +125,49 @@ fn run(
         }
     }
     Ok(c.finish())
+}
+
+/// A model whose panics become errors, as the plugin guard reports them, so
+/// a panic fails the check that called it instead of unwinding through the
+/// suite.
+struct Caught<'a>(&'a dyn WorkloadModel);
+
+impl Caught<'_> {
+    fn run<T>(&self, method: &str, f: impl FnOnce() -> crate::Result<T>) -> crate::Result<T> {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|p| {
+            Err(crate::HilError::Plugin {
+                path: super::under_test(),
+                why: format!(
+                    "`{}` panicked in {method}: {}",
+                    self.0.name(),
+                    crate::plugin::panic_message(&*p)
+                ),
+            })
+        })
+    }
+}
+
+impl WorkloadModel for Caught<'_> {
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+    fn predict(
+        &self,
+        wl0: f64,
+        history: &crate::QueryHistory,
+        t: crate::Timestep,
+    ) -> crate::Result<f64> {
+        self.run("predict", || self.0.predict(wl0, history, t))
+    }
+    fn predict_if_queried(
+        &self,
+        wl0: f64,
+        history: &crate::QueryHistory,
+        t: crate::Timestep,
+        kind: QueryKind,
+    ) -> crate::Result<f64> {
+        self.run("predict_if_queried", || {
+            self.0.predict_if_queried(wl0, history, t, kind)
+        })
+    }
 }

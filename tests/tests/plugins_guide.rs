@@ -48,7 +48,6 @@ fn the_guide_shows_the_example_crate_verbatim() {
         assert_eq!(block, &actual, "PLUGINS.md's copy of {path} is out of date");
     }
     let snippets = marked_blocks(&text, "guide-snippet");
-    assert!(!snippets.is_empty());
     for (path, block) in &snippets {
         let actual = std::fs::read_to_string(common::workspace_root().join(path)).unwrap();
         assert!(
@@ -78,7 +77,7 @@ fn the_guide_plugin_loads_conforms_and_runs_from_the_guide_config() {
     let configs = marked_blocks(&guide(), "guide-config");
     assert_eq!(configs.len(), 1);
     let snippet = configs[0].1.replace(
-        "\"target/debug/libmy_plugin.so\"",
+        "\"target/release/libmy_plugin.so\"",
         &format!(
             "{:?}, {:?}, {:?}",
             path.display().to_string(),

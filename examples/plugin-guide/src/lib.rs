@@ -115,14 +115,13 @@ hil_core::declare_plugin!(register);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hil_core::ActionSpace;
+    use hil_core::testing::CheckOptions;
 
-    #[test]
-    fn conforms() {
-        let mut ctx = BuildContext::new(".", 0);
-        ctx.action_space = Some(ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap());
-        ctx.context_dim = Some(4);
-        let params = Params::toml("n_ask = 2");
-        hil_core::testing::check_policy(&|| build(&params, &ctx)).unwrap();
+    // One test per conformance property, named after it.
+    hil_core::conformance_tests! {
+        policy ask_first_items {
+            options: CheckOptions::default().with_context_dim(4),
+            make: |opts| build(&Params::toml("n_ask = 2"), &opts.build_context()),
+        }
     }
 }

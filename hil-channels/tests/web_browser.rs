@@ -320,6 +320,7 @@ fn contrast(a: &str, b: &str) -> f64 {
 }
 
 #[test]
+#[ignore = "e2e: needs Chromium; bash scripts/test runs it"]
 fn a_person_answers_every_kind_of_query_in_chromium() {
     if !tools_present() {
         return;

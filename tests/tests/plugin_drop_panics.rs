@@ -12,6 +12,7 @@ use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
 use hil_core::{BuildContext, HilError};
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn every_kind_of_object_reports_a_destructor_panic_to_the_host() {
     let krate = "hil-test-plugin-panicky";
     let ws = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();

@@ -81,6 +81,7 @@ fn observe(p: &mut dyn Policy) -> hil_core::Result<()> {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn policy_panics_are_errors() {
     load();
     let build = |m: &str| plugin::build_policy("panicky_policy", &params(m), &ctx());
@@ -113,6 +114,7 @@ fn policy_panics_are_errors() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn environment_panics_are_errors() {
     load();
     let build = |m: &str| plugin::build_environment("panicky_env", &params(m), &ctx());
@@ -153,6 +155,7 @@ fn environment_panics_are_errors() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn workload_model_panics_are_errors() {
     load();
     let build = |m: &str| plugin::build_workload_model("panicky_workload", &params(m), &ctx());
@@ -175,6 +178,7 @@ fn workload_model_panics_are_errors() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn query_channel_panics_are_errors() {
     load();
     let build = |m: &str| plugin::build_query_channel("panicky_channel", &params(m), &ctx());

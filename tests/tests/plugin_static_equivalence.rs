@@ -55,6 +55,7 @@ fn episodes(policy: &mut dyn Policy, n: usize) -> Vec<EpisodeReport> {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn static_and_plugin_policies_decide_identically() {
     let info = plugin::load(&common::lib("hil-example-policy-thompson")).unwrap();
     assert_eq!(info.components[0].name, hil_example_policy_thompson::NAME);
@@ -84,6 +85,7 @@ fn static_and_plugin_policies_decide_identically() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn the_static_policy_passes_its_conformance_suite_through_the_plugin_too() {
     plugin::load(&common::lib("hil-example-policy-thompson")).unwrap();
     let report = hil_core::testing::check_policy(&|| {

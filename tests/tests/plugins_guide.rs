@@ -58,6 +58,7 @@ fn the_guide_shows_the_example_crate_verbatim() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn the_guide_plugin_loads_conforms_and_runs_from_the_guide_config() {
     let path = common::lib("hil-example-plugin-guide");
     let info = plugin::load(&path).unwrap();

@@ -2,7 +2,7 @@
 //! identical decisions for the same seed, and checkpoints cross the
 //! boundary both ways.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 
@@ -92,5 +92,10 @@ fn the_static_policy_passes_its_conformance_suite_through_the_plugin_too() {
         plugin::build_policy("linear_thompson", &Params::empty(), &ctx(6))
     })
     .unwrap();
-    assert!(report.passed.contains(&"checkpoint"), "{report:?}");
+    assert!(
+        report
+            .passed
+            .contains(&hil_core::testing::Check::Checkpoint),
+        "{report:?}"
+    );
 }

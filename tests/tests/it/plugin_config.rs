@@ -1,7 +1,7 @@
 //! Plugin types in experiment configs: named like built-in types, loaded
 //! before the components are parsed, with located errors.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

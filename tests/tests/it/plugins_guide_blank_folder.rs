@@ -3,7 +3,7 @@
 //! (`hil/`, here a link to this workspace), and the README's release `hil`
 //! (`hil/scripts/hil`) lists and checks it.
 
-mod common;
+use crate::common;
 
 /// The guide's steps in document order: `Run(script)` for a block after
 /// `<!-- guide-run -->`, `Write(path, text)` after `<!-- guide-write: PATH -->`.

@@ -2,7 +2,7 @@
 //! is an error (or, for methods that cannot fail, a poisoned object whose
 //! next fallible call is an error), and the host process carries on.
 
-mod common;
+use crate::common;
 
 use hil_core::plugin::{self, Params};
 use hil_core::{

@@ -2,7 +2,7 @@
 //! that crate builds and loads as a plugin, its type conforms, and the
 //! guide's config snippet runs.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! Loading plugins: every refusal is a clear error naming the file, and
 //! loading is idempotent.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -4,7 +4,7 @@
 //! context) fails `rejects_wrong_dimension`, and `rejection_has_no_effect`
 //! (the panic leaves it unusable), and passes every other property.
 
-mod common;
+use crate::common;
 
 #[test]
 #[ignore = "e2e: needs a nested cargo test of a test plugin; bash scripts/test runs it"]

@@ -20,6 +20,7 @@ fn every_kind_of_object_reports_a_destructor_panic_to_the_host() {
     plugin::load(&lib).unwrap();
     let ctx = BuildContext::new(".", 0);
     let p = Params::toml("panic_in = \"drop\"");
+    let _lock = crate::common::destructor_panics_lock();
     assert!(plugin::take_destructor_panics().is_empty());
 
     drop(plugin::build_policy("panicky_policy", &p, &ctx).unwrap());

@@ -110,7 +110,9 @@ fn policy_panics_are_errors() {
     decide(p.as_mut()).unwrap();
     observe(p.as_mut()).unwrap();
     // Dropping one that panics in its destructor does not take the host down.
+    let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
+    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
@@ -151,7 +153,9 @@ fn environment_panics_are_errors() {
     assert_eq!(e.current_item(), Some(&item));
     assert_eq!(e.best_action(), Some(ArmId(1)));
     assert_eq!(e.action_space().len(), 2);
+    let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
+    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
@@ -174,7 +178,9 @@ fn workload_model_panics_are_errors() {
         m.predict_if_queried(0.5, &h, 1, QueryKind::default()),
         "predict_if_queried",
     );
+    let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
+    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
@@ -204,7 +210,9 @@ fn query_channel_panics_are_errors() {
     assert_poisoned(c.ask(&q), "seed");
     let mut c = build("").unwrap();
     assert_eq!(c.ask(&q).unwrap().expert_arm, Some(ArmId(0)));
+    let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
+    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]

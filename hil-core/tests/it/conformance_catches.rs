@@ -26,6 +26,9 @@ fn options() -> CheckOptions {
 
 type Run = Result<ConformanceReport, ConformanceFailure>;
 
+/// A suite run, whole (`None`) or of one property.
+type Runner<'a> = &'a dyn Fn(Option<Check>) -> Run;
+
 fn policy_runs(d: Option<PolicyDefect>, only: Option<Check>) -> Run {
     let opts = options();
     let make = || broken::policy(d, &opts);
@@ -132,7 +135,7 @@ fn every_check_has_a_broken_implementation() {
 
 #[test]
 fn the_unbroken_implementations_pass_every_property() {
-    let subjects: [(Subject, &dyn Fn(Option<Check>) -> Run); 4] = [
+    let subjects: [(Subject, Runner<'_>); 4] = [
         (Subject::Policy, &|only| policy_runs(None, only)),
         (Subject::Environment, &|only| environment_runs(None, only)),
         (Subject::WorkloadModel, &|only| workload_runs(None, only)),

@@ -80,8 +80,8 @@ pub enum ParamFormat {
 /// assert_eq!(p.alpha, 2.0);
 /// assert!(Params::json("{}").parse::<P>("my_policy").is_err());
 /// // Several keys on one line are not TOML; the error points to the JSON form.
-/// let e = Params::toml("alpha = 0.5, beta = 1").parse::<P>("my_policy").unwrap_err();
-/// assert!(matches!(e, hil_core::HilError::Serde { .. }));
+/// let r = Params::toml("alpha = 0.5, beta = 1").parse::<P>("my_policy");
+/// assert!(matches!(r, Err(hil_core::HilError::Serde { .. })));
 /// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Params {

@@ -145,10 +145,13 @@ hil_core::declare_plugin!(register);
 mod tests {
     use super::*;
 
-    #[test]
-    fn passes_the_channel_conformance_suite() {
-        let mut ch = build(&Params::empty(), &BuildContext::new(".", 0)).unwrap();
-        hil_core::testing::check_query_channel(ch.as_mut(), 60).unwrap();
+    // One test per property; built through the factory, so seeded replay
+    // is checked too.
+    hil_core::conformance_tests! {
+        query_channel noisy_expert {
+            options: hil_core::testing::CheckOptions::default().with_queries(60),
+            make: |opts| build(&Params::empty(), &opts.build_context()),
+        }
     }
 
     #[test]

@@ -37,6 +37,7 @@ fn bench(extra: &[&str]) -> (bool, Value, String) {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn plugin_policy_runs() {
     let krate = "hil-example-policy-thompson";
     let root = Path::new(env!("CARGO_MANIFEST_DIR"))

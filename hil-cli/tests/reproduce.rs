@@ -251,6 +251,7 @@ type = "simulated_expert"
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_plugin_policy_runs_in_reproduce_settings() {
     let krate = "hil-example-policy-thompson";
     let ws = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();

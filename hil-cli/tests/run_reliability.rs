@@ -199,6 +199,7 @@ fn a_second_writer_is_refused_naming_the_first() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_plugin_destructor_panic_is_reported_and_fails_the_run() {
     let krate = "hil-test-plugin-panicky";
     let ws = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();

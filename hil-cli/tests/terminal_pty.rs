@@ -81,6 +81,7 @@ fn logged_responses(log: &Path) -> Vec<serde_json::Value> {
 }
 
 #[test]
+#[ignore = "e2e: needs a PTY (python3 pty); bash scripts/test runs it"]
 fn answered_interrupted_and_resumed_through_a_pty() {
     let dir = tmp_dir("interrupt");
     let config = dir.join("terminal.toml");
@@ -172,6 +173,7 @@ fn answered_interrupted_and_resumed_through_a_pty() {
 }
 
 #[test]
+#[ignore = "e2e: needs a PTY (python3 pty); bash scripts/test runs it"]
 fn end_of_input_stops_with_a_clear_error() {
     let dir = tmp_dir("eof");
     let config = dir.join("terminal.toml");

@@ -20,10 +20,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use hil_core::TaskContext;
 use hil_core::plugin::{Params, Registrar};
 use hil_core::{
     Answer, ArmId, Difficulty, Distraction, HilError, Query, QueryChannel, Response, Result,
+    TaskContext,
 };
 
 /// The name the plugin registers.
@@ -114,7 +114,7 @@ impl QueryChannel for NoisyExpert {
         };
         let time = (lo + (hi - lo) * self.rng.random::<f64>()) * slow;
         let decline = (self.p.decline + if hard { self.p.hard_decline } else { 0.0 }).min(1.0);
-        let mut r = if self.rng.random_bool(decline) {
+        let r = if self.rng.random_bool(decline) {
             Response::without_action(Answer::Declined)
         } else if n > 1 && self.rng.random_bool(self.p.error) {
             // A wrong answer: any action but the best.
@@ -123,8 +123,7 @@ impl QueryChannel for NoisyExpert {
         } else {
             Response::action(best)
         };
-        r.response_time_s = Some(time);
-        Ok(r)
+        Ok(r.with_response_time(time))
     }
 }
 
@@ -151,20 +150,19 @@ hil_core::declare_plugin!(register);
 mod tests {
     use super::*;
 
-    fn ctx() -> TaskContext {
-        let actions = hil_core::ActionSpace::new(["a", "b", "c"]).unwrap();
-        TaskContext::new(hil_core::BuildContext::new(".", 0), actions, 4)
-    }
-
-    #[test]
-    fn passes_the_channel_conformance_suite() {
-        let mut ch = build(&Params::empty(), &ctx()).unwrap();
-        hil_core::testing::check_query_channel(ch.as_mut(), 60).unwrap();
+    // One test per property; built through the factory, so seeded replay
+    // is checked too.
+    hil_core::conformance_tests! {
+        query_channel noisy_expert {
+            options: hil_core::testing::CheckOptions::default().with_queries(60),
+            make: |opts| build(&Params::empty(), &opts.task_context()),
+        }
     }
 
     #[test]
     fn rejects_bad_parameters() {
-        let e = build(&Params::toml("error = 1.5"), &ctx()).err().unwrap();
+        let ctx = hil_core::testing::CheckOptions::default().task_context();
+        let e = build(&Params::toml("error = 1.5"), &ctx).err().unwrap();
         assert!(e.to_string().contains("`error`"), "{e}");
     }
 }

@@ -269,13 +269,12 @@ hil_core::declare_plugin!(register);
 mod tests {
     use super::*;
 
-    #[test]
-    fn passes_the_environment_conformance_suite() {
-        hil_core::testing::check_environment(
-            &|| build(&Params::empty(), &BuildContext::new(".", 0)),
-            3,
-        )
-        .unwrap();
+    // One test per property.
+    hil_core::conformance_tests! {
+        environment grasp_choice {
+            options: hil_core::testing::CheckOptions::default().with_attempts(3),
+            make: |opts| build(&Params::empty(), &opts.build_context()),
+        }
     }
 
     #[test]

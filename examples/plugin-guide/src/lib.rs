@@ -8,10 +8,11 @@
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use hil_core::TaskContext;
 use hil_core::plugin::{Params, Registrar};
 use hil_core::policy::{check_feedback, check_input};
-use hil_core::{ArmId, Decision, DecisionInput, Feedback, HilError, Policy, QueryKind, Result};
+use hil_core::{
+    ArmId, Decision, DecisionInput, Feedback, HilError, Policy, QueryKind, Result, TaskContext,
+};
 
 /// The parameters, as written in a config's `[policy]` section.
 #[derive(Debug, Deserialize)]
@@ -108,16 +109,13 @@ hil_core::declare_plugin!(register);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hil_core::ActionSpace;
+    use hil_core::testing::CheckOptions;
 
-    #[test]
-    fn conforms() {
-        let ctx = TaskContext::new(
-            hil_core::BuildContext::new(".", 0),
-            ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap(),
-            4,
-        );
-        let params = Params::toml("n_ask = 2");
-        hil_core::testing::check_policy(&|| build(&params, &ctx)).unwrap();
+    // One test per conformance property, named after it.
+    hil_core::conformance_tests! {
+        policy ask_first_items {
+            options: CheckOptions::default().with_context_dim(4),
+            make: |opts| build(&Params::toml("n_ask = 2"), &opts.task_context()),
+        }
     }
 }

@@ -349,8 +349,16 @@ mod tests {
         )
     }
 
+    // One test per property (checkpointing included: none is skipped).
+    hil_core::conformance_tests! {
+        policy linear_thompson {
+            options: hil_core::testing::CheckOptions::default().with_context_dim(5),
+            make: |opts| build(&Params::empty(), &opts.task_context()),
+        }
+    }
+
     #[test]
-    fn passes_the_policy_conformance_suite() {
+    fn passes_the_whole_policy_suite_without_skipping() {
         let report = hil_core::testing::check_policy(&|| build(&Params::empty(), &ctx())).unwrap();
         assert!(report.skipped.is_empty(), "{report:?}");
     }

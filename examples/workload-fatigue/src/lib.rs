@@ -158,10 +158,12 @@ hil_core::declare_plugin!(register);
 mod tests {
     use super::*;
 
-    #[test]
-    fn passes_the_workload_conformance_suite() {
-        let m = build(&Params::empty(), &BuildContext::new(".", 0)).unwrap();
-        hil_core::testing::check_workload_model(m.as_ref()).unwrap();
+    // One test per property.
+    hil_core::conformance_tests! {
+        workload_model fatigue {
+            options: hil_core::testing::CheckOptions::default(),
+            make: |opts| build(&Params::empty(), &opts.build_context()),
+        }
     }
 
     #[test]

@@ -4,12 +4,12 @@
 
 use std::path::PathBuf;
 
-use hil_core::TaskContext;
-use hil_core::plugin::{self, ComponentInfo, ComponentKind, Params, PluginInfo};
+use hil_core::plugin::{self, BuildFacts, ComponentInfo, ComponentKind, Params, PluginInfo};
 use hil_core::testing::{
-    ConformanceReport, check_environment, check_policy, check_query_channel, check_workload_model,
+    Check, CheckOptions, ConformanceFailure, ConformanceReport, check_environment_with,
+    check_policy_with, check_query_channel_with, check_workload_model_with,
 };
-use hil_core::{ActionSpace, BuildContext, HilError};
+use hil_core::{ActionSpace, HilError};
 
 /// Arguments of `hil plugins`.
 #[derive(Debug, clap::Args)]
@@ -34,19 +34,33 @@ pub enum PluginsCommand {
     Check {
         /// The plugin library.
         path: PathBuf,
-        /// Parameters for a type, `NAME=TEXT`: TOML (`alpha = 0.5`) or, if
-        /// TEXT starts with `{`, JSON. Types without it get no parameters.
+        /// Parameters for a type, `NAME=TEXT`: TEXT is TOML, one `key = value`
+        /// per line (`NAME='alpha = 0.5'`), or, if it starts with `{`, JSON,
+        /// the form for several keys on one line
+        /// (`NAME='{"alpha": 0.5, "beta": 2}'`). Types without it get no
+        /// parameters.
         #[arg(long = "params", value_name = "NAME=TEXT")]
         params: Vec<String>,
-        /// Context dimension policies are built for.
+        /// Action names policies are built for and channels are asked over,
+        /// comma-separated (default: six task-neutral names, `a` to `f`).
+        #[arg(long, value_delimiter = ',', value_name = "NAME,NAME,...")]
+        actions: Option<Vec<String>>,
+        /// Context dimension policies are built for and channels are shown.
         #[arg(long, default_value_t = 8)]
         dim: usize,
         /// Queries asked of each query channel.
-        #[arg(long, default_value_t = 60)]
+        #[arg(long, default_value_t = 36)]
         queries: usize,
         /// Attempts per item when checking environments.
         #[arg(long, default_value_t = 3)]
         attempts: u32,
+    },
+    /// Print this host's build facts: a plugin loads only if it was built
+    /// with the same ones (build it with the profile and toolchain shown).
+    Abi {
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -56,11 +70,78 @@ pub fn run(args: PluginsArgs) -> hil_core::Result<()> {
         PluginsCommand::Check {
             path,
             params,
+            actions,
             dim,
             queries,
             attempts,
-        } => check(&path, &params, dim, queries, attempts),
+        } => {
+            let opts = options(actions, dim, queries, attempts)?;
+            check(&path, &params, &opts)
+        }
+        PluginsCommand::Abi { json } => {
+            abi(json);
+            Ok(())
+        }
     }
+}
+
+/// The conformance options of `hil plugins check`.
+fn options(
+    actions: Option<Vec<String>>,
+    dim: usize,
+    queries: usize,
+    attempts: u32,
+) -> hil_core::Result<CheckOptions> {
+    let mut opts = CheckOptions::default()
+        .with_context_dim(dim)
+        .with_queries(queries)
+        .with_attempts(attempts);
+    if let Some(names) = actions {
+        let space = ActionSpace::new(names.iter().map(|n| n.trim().to_string())).map_err(|e| {
+            HilError::invalid_parameter("--actions", names.join(","), e.to_string())
+        })?;
+        opts = opts.with_actions(space);
+    }
+    opts.validate().map_err(|e| match e {
+        HilError::InvalidParameter { name, value, why } => HilError::InvalidParameter {
+            name: format!(
+                "--{}",
+                if name == "context_dim" {
+                    "dim"
+                } else {
+                    name.as_str()
+                }
+            ),
+            value,
+            why,
+        },
+        other => other,
+    })?;
+    Ok(opts)
+}
+
+/// `hil plugins abi`: the facts a plugin must share with this host.
+fn abi(json: bool) {
+    let facts = BuildFacts::current();
+    if json {
+        let mut map = serde_json::Map::new();
+        map.insert("abi_version".into(), plugin::ABI_VERSION.into());
+        for (k, v) in facts.fields() {
+            map.insert(k.into(), v.into());
+        }
+        println!("{}", serde_json::Value::Object(map));
+        return;
+    }
+    println!("ABI version: {}", plugin::ABI_VERSION);
+    for (k, v) in facts.fields() {
+        println!("{k}: {v}");
+    }
+    let release = facts.profile.to_string_lossy() == "release";
+    println!(
+        "build plugins for this host with `cargo build{}` using {}, against this hil-core and with this workspace's Cargo.lock",
+        if release { " --release" } else { "" },
+        facts.rustc_version.to_string_lossy()
+    );
 }
 
 fn list(paths: &[PathBuf], json: bool) -> hil_core::Result<()> {
@@ -154,45 +235,58 @@ fn parse_params(specs: &[String], info: &PluginInfo) -> hil_core::Result<Vec<(St
         .collect()
 }
 
-fn check(
+/// The outcome of each registered type's suite, in registration order.
+type Outcomes = Vec<(ComponentInfo, Result<ConformanceReport, ConformanceFailure>)>;
+
+/// Loads the library and runs every registered type's suite.
+fn run_checks(
     path: &std::path::Path,
     specs: &[String],
-    dim: usize,
-    queries: usize,
-    attempts: u32,
-) -> hil_core::Result<()> {
-    if dim == 0 {
-        return Err(HilError::invalid_parameter(
-            "--dim",
-            0,
-            "must be at least 1",
-        ));
-    }
+    opts: &CheckOptions,
+) -> hil_core::Result<(PluginInfo, Outcomes)> {
     let info = plugin::load(path)?;
     let params = parse_params(specs, &info)?;
+    let outcomes = info
+        .components
+        .iter()
+        .map(|c| {
+            let p = params
+                .iter()
+                .rev()
+                .find(|(n, _)| *n == c.name)
+                .map_or_else(Params::empty, |(_, p)| p.clone());
+            (c.clone(), check_one(c, &p, opts))
+        })
+        .collect();
+    Ok((info, outcomes))
+}
+
+fn check(path: &std::path::Path, specs: &[String], opts: &CheckOptions) -> hil_core::Result<()> {
+    let (info, outcomes) = run_checks(path, specs, opts)?;
     print_info(&info);
+    println!(
+        "  checked over {} actions ({}), context dimension {}",
+        opts.actions().len(),
+        opts.actions().names().join(", "),
+        opts.context_dim()
+    );
     let mut failed = 0;
-    for c in &info.components {
-        let p = params
-            .iter()
-            .rev()
-            .find(|(n, _)| *n == c.name)
-            .map_or_else(Params::empty, |(_, p)| p.clone());
-        match check_one(c, &p, dim, queries, attempts) {
+    for (c, outcome) in &outcomes {
+        match outcome {
             Ok(report) => {
                 println!(
                     "ok    {} `{}`: passed {}",
                     c.kind,
                     c.name,
-                    report.passed.join(", ")
+                    report.passed_names()
                 );
                 for (check, why) in &report.skipped {
                     println!("      skipped {check}: {why}");
                 }
             }
-            Err(why) => {
+            Err(f) => {
                 failed += 1;
-                println!("FAIL  {} `{}`: {why}", c.kind, c.name);
+                println!("FAIL  {} `{}`: property `{}`: {f}", c.kind, c.name, f.check);
             }
         }
     }
@@ -201,45 +295,44 @@ fn check(
             path: info.path,
             why: format!(
                 "{failed} of {} types failed their conformance suite",
-                info.components.len()
+                outcomes.len()
             ),
         });
     }
-    println!("all {} types conform", info.components.len());
+    println!("all {} types conform", outcomes.len());
     Ok(())
 }
 
+/// Runs the suite of `c`'s trait on objects built from `params` and the
+/// options' build context.
 fn check_one(
     c: &ComponentInfo,
     params: &Params,
-    dim: usize,
-    queries: usize,
-    attempts: u32,
-) -> Result<ConformanceReport, String> {
-    let ctx = TaskContext::new(
-        BuildContext::new(".", 0),
-        ActionSpace::clone(hil_envs::feeding::FeedingTask::bundled().action_space()),
-        dim,
-    );
+    opts: &CheckOptions,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    let (ctx, task) = (opts.build_context(), opts.task_context());
     let name = c.name.as_str();
-    let r = match c.kind {
-        ComponentKind::Policy => check_policy(&|| plugin::build_policy(name, params, &ctx)),
-        ComponentKind::Environment => check_environment(
-            &|| plugin::build_environment(name, params, ctx.base()),
-            attempts,
-        ),
+    match c.kind {
+        ComponentKind::Policy => {
+            check_policy_with(&|| plugin::build_policy(name, params, &task), opts)
+        }
+        ComponentKind::Environment => {
+            check_environment_with(&|| plugin::build_environment(name, params, &ctx), opts)
+        }
         ComponentKind::WorkloadModel => {
-            let m = plugin::build_workload_model(name, params, ctx.base())
-                .map_err(|e| e.to_string())?;
-            check_workload_model(m.as_ref())
+            let m = plugin::build_workload_model(name, params, &ctx).map_err(|e| {
+                ConformanceFailure {
+                    subject: name.to_string(),
+                    check: Check::Build,
+                    detail: e.to_string(),
+                }
+            })?;
+            check_workload_model_with(m.as_ref(), opts)
         }
         ComponentKind::QueryChannel => {
-            let mut ch =
-                plugin::build_query_channel(name, params, &ctx).map_err(|e| e.to_string())?;
-            check_query_channel(ch.as_mut(), queries)
+            check_query_channel_with(&|| plugin::build_query_channel(name, params, &task), opts)
         }
-    };
-    r.map_err(|e| e.to_string())
+    }
 }
 
 #[cfg(test)]
@@ -258,32 +351,78 @@ mod tests {
                 "hil-example-plugin-guide",
                 "hil-test-plugin-panicky",
                 "hil-test-plugin-mismatched-abi",
+                "hil-test-plugin-unchecked-context",
             ],
         )
         .unwrap()
     }
 
-    #[test]
-    fn check_passes_a_conforming_plugin_and_fails_a_broken_one() {
-        let dir = libs();
-        let guide = cdylib_path(&dir, "hil-example-plugin-guide");
-        check(&guide, &["ask_first_items=n_ask = 1".into()], 8, 30, 3).unwrap();
-        // Without its required parameter the factory refuses: a failure.
-        let e = check(&guide, &[], 8, 30, 3).unwrap_err();
-        assert!(e.to_string().contains("1 of 1 types failed"), "{e}");
-        // The panicky test plugin's components do not validate their inputs.
-        let e = check(&cdylib_path(&dir, "hil-test-plugin-panicky"), &[], 8, 30, 3).unwrap_err();
-        assert!(
-            e.to_string()
-                .contains("types failed their conformance suite"),
-            "{e}"
-        );
-        // Parameters for a type the library does not register.
-        let e = check(&guide, &["ask_first_item=n_ask = 1".into()], 8, 30, 3).unwrap_err();
-        assert!(e.to_string().contains("closest: ask_first_items"), "{e}");
+    fn opts() -> CheckOptions {
+        options(None, 8, 30, 3).unwrap()
     }
 
     #[test]
+    #[ignore = "e2e: needs a nested cargo build of the test plugins; bash scripts/test runs it"]
+    fn check_passes_a_conforming_plugin_and_fails_a_broken_one() {
+        let dir = libs();
+        let guide = cdylib_path(&dir, "hil-example-plugin-guide");
+        check(&guide, &["ask_first_items=n_ask = 1".into()], &opts()).unwrap();
+        // Without its required parameter the factory refuses: a build failure.
+        let (_, outcomes) = run_checks(&guide, &[], &opts()).unwrap();
+        assert_eq!(outcomes[0].1.as_ref().unwrap_err().check, Check::Build);
+        assert!(matches!(
+            check(&guide, &[], &opts()),
+            Err(HilError::Plugin { .. })
+        ));
+        // The panicky test plugin's policy is 2-armed whatever the context.
+        let (_, outcomes) =
+            run_checks(&cdylib_path(&dir, "hil-test-plugin-panicky"), &[], &opts()).unwrap();
+        let policy = outcomes
+            .iter()
+            .find(|(c, _)| c.kind == ComponentKind::Policy)
+            .unwrap();
+        assert_eq!(policy.1.as_ref().unwrap_err().check, Check::PolicyShape);
+        // Parameters for a type the library does not register.
+        let e = check(&guide, &["ask_first_item=n_ask = 1".into()], &opts()).unwrap_err();
+        assert!(
+            matches!(&e, HilError::InvalidParameter { name, .. } if name == "--params"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    #[ignore = "e2e: needs a nested cargo build of the test plugins; bash scripts/test runs it"]
+    fn a_policy_that_panics_on_a_longer_context_fails_naming_the_property() {
+        let dir = libs();
+        let lib = cdylib_path(&dir, "hil-test-plugin-unchecked-context");
+        let (_, outcomes) = run_checks(&lib, &[], &opts()).unwrap();
+        let failure = outcomes[0].1.as_ref().unwrap_err();
+        assert_eq!(failure.check, Check::RejectsWrongDimension, "{failure}");
+        assert!(matches!(
+            check(&lib, &[], &opts()),
+            Err(HilError::Plugin { .. })
+        ));
+    }
+
+    #[test]
+    fn options_come_from_the_flags_and_are_validated() {
+        let o = options(Some(vec!["grasp".into(), " lift".into()]), 3, 5, 2).unwrap();
+        assert_eq!(o.actions().names(), ["grasp", "lift"]);
+        assert_eq!(o.context_dim(), 3);
+        for bad in [
+            options(None, 0, 5, 2),
+            options(None, 3, 0, 2),
+            options(Some(vec!["a".into(), "a".into()]), 3, 5, 2),
+        ] {
+            assert!(
+                matches!(bad, Err(HilError::InvalidParameter { ref name, .. }) if name.starts_with("--")),
+                "{bad:?}"
+            );
+        }
+    }
+
+    #[test]
+    #[ignore = "e2e: needs a nested cargo build of the test plugins; bash scripts/test runs it"]
     fn list_reports_every_library_and_fails_if_any_is_refused() {
         let dir = libs();
         list(&[cdylib_path(&dir, "hil-example-plugin-guide")], true).unwrap();

@@ -133,14 +133,39 @@ fn check_header(path: &Path, header: &PluginHeader) -> Result<()> {
         .map(|(h, p)| format!("{}: plugin {:?}, host {:?}", h.0, p.1, h.1))
         .collect();
     if mismatches.is_empty() {
-        Ok(())
-    } else {
-        Err(refuse(
-            path,
-            format!(
-                "version mismatch ({}); Rust has no stable ABI, so rebuild the plugin with the host's toolchain, hil-core version and profile",
-                mismatches.join("; ")
-            ),
-        ))
+        return Ok(());
     }
+    let differs = |name: &str| {
+        host.iter()
+            .zip(plugin.iter())
+            .any(|(h, p)| h.0 == name && h.1 != p.1)
+    };
+    let mut fixes = Vec::new();
+    if differs("build profile") {
+        let release = BuildFacts::current().profile.to_string_lossy() == "release";
+        fixes.push(if release {
+            "this host is a release build: build the plugin with `cargo build --release`"
+        } else {
+            "this host is a debug build: build the plugin with `cargo build` (no --release)"
+        });
+    }
+    if differs("rustc version") {
+        fixes.push("build the plugin with the host's rustc (see `rustup show`; pin it in rust-toolchain.toml)");
+    }
+    if differs("hil-core version") {
+        fixes.push("depend on the host's hil-core (the same path or git revision)");
+    }
+    if differs("interface layout") {
+        fixes.push(
+            "the types that cross the boundary are laid out differently although the versions agree: the plugin resolved other versions or features of hil-core's dependencies (serde_json, ...); build it with the host's Cargo.lock (copy it next to the plugin's Cargo.toml) or inside the host's workspace",
+        );
+    }
+    Err(refuse(
+        path,
+        format!(
+            "version mismatch ({}); Rust has no stable ABI, so a plugin must be built exactly like its host: {}. `hil plugins abi` prints the host's build facts",
+            mismatches.join("; "),
+            fixes.join("; ")
+        ),
+    ))
 }

@@ -81,6 +81,8 @@ pub use registry::{
 #[doc(hidden)]
 pub use registrar::run_register as __run_register;
 
+pub(crate) use guard::panic_message;
+
 use std::path::Path;
 
 use crate::error::Result;

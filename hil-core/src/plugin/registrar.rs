@@ -79,6 +79,9 @@ pub enum ParamFormat {
 /// let p: P = Params::json(r#"{"alpha": 2.0}"#).parse("my_policy").unwrap();
 /// assert_eq!(p.alpha, 2.0);
 /// assert!(Params::json("{}").parse::<P>("my_policy").is_err());
+/// // Several keys on one line are not TOML; the error points to the JSON form.
+/// let r = Params::toml("alpha = 0.5, beta = 1").parse::<P>("my_policy");
+/// assert!(matches!(r, Err(hil_core::HilError::Serde { .. })));
 /// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Params {
@@ -125,7 +128,15 @@ impl Params {
         let what = || format!("parameters of `{type_name}`");
         match self.format {
             ParamFormat::Toml => {
-                toml::from_str(&self.text).map_err(|e| HilError::serde(what(), e.message().trim()))
+                toml::from_str(&self.text).map_err(|e| {
+                    let mut why = e.message().trim().to_string();
+                    if one_line_of_several_keys(&self.text) {
+                        why.push_str(
+                            "; several keys on one line are not TOML: give them as JSON instead (`{\"a\": 1, \"b\": 2}`), or one `key = value` per line",
+                        );
+                    }
+                    HilError::serde(what(), why)
+                })
             }
             ParamFormat::Json => {
                 let text = if self.text.trim().is_empty() {
@@ -137,6 +148,13 @@ impl Params {
             }
         }
     }
+}
+
+/// Whether a TOML text that failed to parse looks like several `key = value`
+/// pairs written on one line (`a = 1, b = 2`), as a command line invites.
+fn one_line_of_several_keys(text: &str) -> bool {
+    text.lines()
+        .any(|l| l.matches('=').count() > 1 && !l.trim_start().starts_with('['))
 }
 
 /// Builds a policy from parameters and the experiment's build context.

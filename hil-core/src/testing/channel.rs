@@ -1,16 +1,18 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::{Checker, ConformanceFailure, ConformanceReport, random_context};
+use super::{Check, CheckOptions, Checker, ConformanceFailure, ConformanceReport, random_context};
 use crate::{
-    ActionSpace, ArmId, Difficulty, Distraction, Item, Query, QueryChannel, QueryKind, ResponseType,
+    ArmId, Difficulty, Distraction, Item, Query, QueryChannel, QueryKind, Response, ResponseType,
 };
 
-/// Runs the query-channel conformance suite: asks `n` queries covering every
-/// response type, difficulty and distraction (over a task-neutral space of six
-/// actions, with an oracle answer set, as a simulated environment would) and checks that every response's expert arm
-/// indexes the action space and that response times are finite and
-/// non-negative.
+type Make<'a> = &'a dyn Fn() -> crate::Result<Box<dyn QueryChannel>>;
+
+/// Runs the query-channel checks that one instance allows: asks `n`
+/// queries covering every response type, difficulty and distraction (over
+/// the default options' six task-neutral actions, with an oracle answer
+/// set, as a simulated environment would). Seeded replay needs a second
+/// instance: prefer [`check_query_channel_with`], which builds them.
 ///
 /// Channels that need a person (terminal, web) are checked with a scripted
 /// person on the other side by their own tests.
@@ -18,48 +20,137 @@ pub fn check_query_channel(
     channel: &mut dyn QueryChannel,
     n: usize,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    let mut c = Checker::new(channel.name());
-    // A task-neutral space: channels must not depend on any one task's
-    // action names.
-    let actions = ActionSpace::new(["a", "b", "c", "d", "e", "f"])
-        .expect("six unique non-empty names form a valid action space");
+    let opts = CheckOptions::default().with_queries(n.max(1));
+    let mut c = Checker::new(channel.name(), None);
+    answers(&mut c, channel, &opts)?;
+    c.skip(
+        Check::SeededReplay,
+        "checked on one instance; check_query_channel_with builds two".into(),
+    );
+    Ok(c.finish())
+}
+
+/// Runs every query-channel property on channels built by `make`, stopping
+/// at the first failure.
+///
+/// Properties, over `opts.queries()` queries covering every response type,
+/// difficulty and distraction, asked over `opts.actions()` with contexts
+/// of `opts.context_dim()`: [`Check::ExpertArmInRange`] (the query's own
+/// action space, not a fixed task's), [`Check::ResponseTime`],
+/// [`Check::AnswerConsistent`] and [`Check::SeededReplay`] (two instances
+/// seeded alike give the same answers and expert arms; response times are
+/// not compared, as a human channel measures them).
+pub fn check_query_channel_with(
+    make: Make<'_>,
+    opts: &CheckOptions,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    run(make, opts, None)
+}
+
+/// Runs one query-channel property alone (see [`check_query_channel_with`]).
+pub fn check_query_channel_only(
+    make: Make<'_>,
+    opts: &CheckOptions,
+    property: Check,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    run(make, opts, Some(property))
+}
+
+fn run(
+    make: Make<'_>,
+    opts: &CheckOptions,
+    only: Option<Check>,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    let make = &super::guarded(make, |o, lib| {
+        let name = o.name().to_string();
+        Ok(Box::new(crate::plugin::GuardedChannel::new(o, lib, &name)?) as Box<dyn QueryChannel>)
+    });
+    let build_failure = |e: crate::HilError| ConformanceFailure {
+        subject: "<query channel factory>".into(),
+        check: Check::Build,
+        detail: e.to_string(),
+    };
+    opts.validate().map_err(build_failure)?;
+    let mut a = make().map_err(build_failure)?;
+    let mut c = Checker::new(a.name(), only);
+    let ra = answers(&mut c, a.as_mut(), opts)?;
+    if c.wants(Check::SeededReplay) {
+        let mut b = c.ok(Check::Build, make())?;
+        let rb = answers(&mut c, b.as_mut(), opts)?;
+        let same =
+            |x: &Response, y: &Response| x.answer == y.answer && x.expert_arm == y.expert_arm;
+        let first = ra.iter().zip(&rb).position(|(x, y)| !same(x, y));
+        c.check(Check::SeededReplay, first.is_none(), || {
+            let i = first.unwrap_or(0);
+            format!(
+                "two instances seeded with 5 answered query {i} differently: {:?} vs {:?}",
+                ra[i], rb[i]
+            )
+        })?;
+    }
+    Ok(c.finish())
+}
+
+/// The one place the suite builds a [`Query`].
+fn query(i: usize, kind: QueryKind, opts: &CheckOptions, rng: &mut ChaCha8Rng) -> Query {
+    let best = ArmId(rng.random_range(0..opts.actions().len()));
+    Query {
+        t: i as u64 + 1,
+        item: Item {
+            index: i,
+            label: "object".into(),
+            description: Some("an object near the edge of the table".into()),
+        },
+        kind,
+        actions: opts.actions().clone(),
+        context: random_context(rng, opts.context_dim()),
+        oracle_best: Some(best),
+    }
+}
+
+/// Seeds `channel` with 5 and asks the options' queries; checks each answer.
+fn answers(
+    c: &mut Checker,
+    channel: &mut dyn QueryChannel,
+    opts: &CheckOptions,
+) -> Result<Vec<Response>, ConformanceFailure> {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     channel.seed(5);
-    for i in 0..n {
+    let n_actions = opts.actions().len();
+    let mut out = Vec::with_capacity(opts.queries());
+    for i in 0..opts.queries() {
         let kind = QueryKind {
             response: ResponseType::ALL[i % 3],
             difficulty: Difficulty::ALL[(i / 3) % 2],
             distraction: Distraction::ALL[(i / 6) % 3],
         };
-        let best = ArmId(rng.random_range(0..actions.len()));
-        let q = Query {
-            t: i as u64 + 1,
-            item: Item {
-                index: i,
-                label: "object".into(),
-                description: Some("an object near the edge of the table".into()),
-            },
-            kind,
-            actions: actions.clone(),
-            context: random_context(&mut rng, 8),
-            oracle_best: Some(best),
-        };
-        let r = c.ok("ask", channel.ask(&q))?;
+        let q = query(i, kind, opts, &mut rng);
+        let r = c.ok(Check::Answers, channel.ask(&q))?;
         c.check(
-            "expert arm in range",
-            r.expert_arm.is_none_or(|a| a.0 < actions.len()),
-            || format!("{:?}", r.expert_arm),
+            Check::ExpertArmInRange,
+            r.expert_arm.is_none_or(|a| a.0 < n_actions),
+            || {
+                format!(
+                    "query {i} offered {n_actions} actions ({}), indices 0..{n_actions}, but the channel answered with expert arm {:?}",
+                    opts.actions().names().join(", "),
+                    r.expert_arm.map(|a| a.0)
+                )
+            },
         )?;
         c.check(
-            "response time",
+            Check::ResponseTime,
             r.response_time_s.is_none_or(|s| s.is_finite() && s >= 0.0),
-            || format!("{:?}", r.response_time_s),
+            || format!("query {i}: response_time_s = {:?}", r.response_time_s),
         )?;
         if let crate::Answer::Action { arm } = r.answer {
-            c.check("answer consistent", r.expert_arm == Some(arm), || {
-                format!("answer {arm:?} but expert_arm {:?}", r.expert_arm)
+            c.check(Check::AnswerConsistent, r.expert_arm == Some(arm), || {
+                format!(
+                    "query {i}: answer {arm:?} but expert_arm {:?}",
+                    r.expert_arm
+                )
             })?;
         }
+        out.push(r);
     }
-    Ok(c.finish())
+    Ok(out)
 }

@@ -1,121 +1,244 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::{Checker, ConformanceFailure, ConformanceReport};
-use crate::{ArmId, Context, Environment, Item, Outcome};
+use super::{Check, CheckOptions, Checker, ConformanceFailure, ConformanceReport};
+use crate::{ArmId, Context, Environment, HilError, Item, Outcome};
 
 /// The most items the suite walks through before it calls an episode endless.
 const MAX_ITEMS: usize = 10_000;
 
+type Make<'a> = &'a dyn Fn() -> crate::Result<Box<dyn Environment>>;
+
 /// Runs the environment conformance suite on environments built by `make`,
-/// with at most `attempts_per_item` attempts at each item.
-///
-/// Checks: a non-empty action space and a positive context dimension; the
-/// same seed replays the same items, contexts and outcomes; contexts have the
-/// declared dimension; success probabilities lie in [0, 1]; `best_action`
-/// indexes the action space; an arm out of range is an error; calls out of
-/// order are errors, not panics; episodes end.
+/// with at most `attempts_per_item` attempts at each item; see
+/// [`check_environment_with`] for the checks.
 pub fn check_environment(
-    make: &dyn Fn() -> crate::Result<Box<dyn Environment>>,
+    make: Make<'_>,
     attempts_per_item: u32,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    let mut a = make().map_err(|e| ConformanceFailure {
+    check_environment_with(
+        make,
+        &CheckOptions::default().with_attempts(attempts_per_item.max(1)),
+    )
+}
+
+/// Runs every environment property on environments built by `make`,
+/// stopping at the first failure.
+///
+/// Properties: [`Check::EnvironmentShape`]; over three episodes of seed 11
+/// (two instances, and one of them reset again) [`Check::EpisodeHasItems`],
+/// [`Check::EpisodesEnd`], [`Check::CurrentItem`],
+/// [`Check::ContextDimension`], [`Check::SuccessProbability`],
+/// [`Check::BestActionInRange`] and [`Check::Replayable`];
+/// [`Check::ExecuteRejectsArmOutOfRange`] (refused with
+/// [`HilError::ArmOutOfRange`], and the attempt can still be executed,
+/// with the outcome of an instance that never saw the bad arm); and
+/// [`Check::OutOfOrderCalls`] (`observe` and `execute` before `next_item`,
+/// and `execute` before `observe`, refused with [`HilError::State`]; a
+/// later `reset` replays the episode).
+pub fn check_environment_with(
+    make: Make<'_>,
+    opts: &CheckOptions,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    run(make, opts, None)
+}
+
+/// Runs one environment property alone (see [`check_environment_with`]).
+pub fn check_environment_only(
+    make: Make<'_>,
+    opts: &CheckOptions,
+    property: Check,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    run(make, opts, Some(property))
+}
+
+fn run(
+    make: Make<'_>,
+    opts: &CheckOptions,
+    only: Option<Check>,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    let make = &super::guarded(make, |o, lib| {
+        let name = o.name().to_string();
+        Ok(
+            Box::new(crate::plugin::GuardedEnvironment::new(o, lib, &name)?)
+                as Box<dyn Environment>,
+        )
+    });
+    let build_failure = |e: HilError| ConformanceFailure {
         subject: "<environment factory>".into(),
-        check: "build",
+        check: Check::Build,
         detail: e.to_string(),
-    })?;
-    let mut c = Checker::new(a.name());
-    let mut b = c.ok("build", make())?;
+    };
+    opts.validate().map_err(build_failure)?;
+    let mut a = make().map_err(build_failure)?;
+    let mut c = Checker::new(a.name(), only);
+    let build = |c: &Checker| c.ok(Check::Build, make());
     let n_arms = a.action_space().len();
     let dim = a.context_dim();
-    c.check("shape", n_arms >= 1 && dim >= 1, || {
-        format!("{n_arms} arms, dimension {dim}")
+    c.check(Check::EnvironmentShape, n_arms >= 1 && dim >= 1, || {
+        format!("{n_arms} arms, context dimension {dim}")
     })?;
-
-    let ea = run(&mut c, a.as_mut(), 11, attempts_per_item);
-    let ea = c.ok("episode", ea)?;
-    let eb = run(&mut c, b.as_mut(), 11, attempts_per_item);
-    let eb = c.ok("episode", eb)?;
-    c.check("replayable", ea == eb, || {
-        "two instances reset with the same seed produced different episodes".into()
-    })?;
-    let again = run(&mut c, a.as_mut(), 11, attempts_per_item);
-    let again = c.ok("episode", again)?;
-    c.check("replayable", ea == again, || {
-        "resetting with the same seed did not replay the episode".into()
-    })?;
-    c.check("episode has items", !ea.is_empty(), || "no items".into())?;
-
-    // Out-of-range arm.
-    c.ok("reset", a.reset(3))?;
-    if c.ok("next_item", a.next_item())?.is_some() {
-        c.ok("observe", a.observe())?;
-        c.check(
-            "rejects arm out of range",
-            a.execute(ArmId(n_arms)).is_err(),
-            || format!("execute accepted arm {n_arms} of {n_arms}"),
-        )?;
+    if n_arms == 0 {
+        // Nothing below can act without an arm.
+        return Err(c.fail(Check::EpisodeRuns, "the action space is empty".into()));
     }
-    // Out-of-order calls on a fresh instance must not panic; errors are fine.
-    let mut fresh = c.ok("build", make())?;
-    let _ = fresh.observe();
-    let _ = fresh.execute(ArmId(0));
-    c.check("out-of-order calls do not panic", true, String::new)?;
+    let attempts = opts.attempts();
+
+    let ea = run_episode(&mut c, a.as_mut(), 11, attempts)?;
+    c.check(Check::EpisodeHasItems, !ea.is_empty(), || {
+        "reset(11) gave an episode without items".into()
+    })?;
+    if c.wants(Check::Replayable) {
+        let mut b = build(&c)?;
+        let eb = run_episode(&mut c, b.as_mut(), 11, attempts)?;
+        c.check(Check::Replayable, ea == eb, || {
+            format!(
+                "two instances reset with seed 11 produced different episodes ({})",
+                first_difference(&ea, &eb)
+            )
+        })?;
+        let again = run_episode(&mut c, a.as_mut(), 11, attempts)?;
+        c.check(Check::Replayable, ea == again, || {
+            format!(
+                "resetting with seed 11 again did not replay the episode ({})",
+                first_difference(&ea, &again)
+            )
+        })?;
+    }
+
+    // An arm out of range: refused, and the attempt is intact.
+    if c.wants(Check::ExecuteRejectsArmOutOfRange) {
+        let check = Check::ExecuteRejectsArmOutOfRange;
+        let (mut a, mut b) = (build(&c)?, build(&c)?);
+        let mut pair = [a.as_mut(), b.as_mut()];
+        for e in &mut pair {
+            c.ok(Check::EpisodeRuns, e.reset(3))?;
+            c.ok(Check::EpisodeRuns, e.next_item())?;
+            c.ok(Check::EpisodeRuns, e.observe())?;
+        }
+        let [a, b] = pair;
+        if a.current_item().is_some() {
+            let r = a.execute(ArmId(n_arms));
+            c.refused(
+                check,
+                &format!("execute(arm {n_arms}) (the action space has arms 0..{n_arms})"),
+                &format!("HilError::ArmOutOfRange {{ arm: {n_arms}, n_arms: {n_arms} }}"),
+                r,
+                |e| matches!(e, HilError::ArmOutOfRange { arm, n_arms: n } if *arm == n_arms && *n == n_arms),
+            )?;
+            let after = a.execute(ArmId(0)).map_err(|e| {
+                c.fail(
+                    check,
+                    format!(
+                        "after refusing arm {n_arms}, execute(arm 0) on the same observation failed: {e}"
+                    ),
+                )
+            })?;
+            let untouched = c.ok(Check::EpisodeRuns, b.execute(ArmId(0)))?;
+            c.check(check, after == untouched, || {
+                format!(
+                    "after refusing arm {n_arms}, execute(arm 0) gave {after:?}; an instance that never saw the bad arm gave {untouched:?}"
+                )
+            })?;
+        }
+    }
+
+    // Calls out of order: refused as such, and harmless.
+    if c.wants(Check::OutOfOrderCalls) {
+        let check = Check::OutOfOrderCalls;
+        let is_state = |e: &HilError| matches!(e, HilError::State { .. });
+        let kind = "HilError::State";
+        let mut fresh = build(&c)?;
+        let r = fresh.observe();
+        c.refused(check, "observe before next_item", kind, r, is_state)?;
+        let r = fresh.execute(ArmId(0));
+        c.refused(check, "execute before next_item", kind, r, is_state)?;
+        c.ok(Check::EpisodeRuns, fresh.reset(11))?;
+        if c.ok(Check::EpisodeRuns, fresh.next_item())?.is_some() {
+            let r = fresh.execute(ArmId(0));
+            c.refused(check, "execute before observe", kind, r, is_state)?;
+        }
+        let replay = run_episode(&mut c, fresh.as_mut(), 11, attempts)?;
+        c.check(check, replay == ea, || {
+            format!(
+                "after refused out-of-order calls, reset(11) did not give the usual episode ({})",
+                first_difference(&ea, &replay)
+            )
+        })?;
+    }
     Ok(c.finish())
 }
 
 type Trace = Vec<(Item, Vec<(Context, Option<ArmId>, Outcome)>)>;
 
-fn run(
+/// Where two traces first differ, for failure messages.
+fn first_difference(a: &Trace, b: &Trace) -> String {
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        if x != y {
+            return format!("first at item {i}: {x:?} vs {y:?}");
+        }
+    }
+    format!("{} items vs {}", a.len(), b.len())
+}
+
+/// One episode of seed `seed` with seeded random arms.
+fn run_episode(
     c: &mut Checker,
     env: &mut dyn Environment,
     seed: u64,
     attempts_per_item: u32,
-) -> crate::Result<Trace> {
-    env.reset(seed)?;
+) -> Result<Trace, ConformanceFailure> {
+    c.ok(Check::EpisodeRuns, env.reset(seed))?;
     let n_arms = env.action_space().len();
     let dim = env.context_dim();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut trace = Vec::new();
-    while let Some(item) = env.next_item()? {
+    while let Some(item) = c.ok(Check::EpisodeRuns, env.next_item())? {
         if trace.len() >= MAX_ITEMS {
-            c.skip("episodes end", format!("stopped after {MAX_ITEMS} items"));
+            c.check(Check::EpisodesEnd, false, || {
+                format!("next_item still returned items after {MAX_ITEMS}")
+            })?;
             break;
         }
-        if c.check("current item", env.current_item() == Some(&item), || {
-            format!(
-                "current_item() = {:?} after next_item() = {item:?}",
-                env.current_item()
-            )
-        })
-        .is_err()
-        {
-            return Err(crate::HilError::state(
-                env.name(),
-                "current_item disagrees with next_item",
-            ));
-        }
+        c.check(
+            Check::CurrentItem,
+            env.current_item() == Some(&item),
+            || {
+                format!(
+                    "current_item() = {:?} after next_item() = {item:?}",
+                    env.current_item()
+                )
+            },
+        )?;
         let mut steps = Vec::new();
         for _ in 0..attempts_per_item.max(1) {
-            let x = env.observe()?;
+            let x = c.ok(Check::EpisodeRuns, env.observe())?;
+            c.check(Check::ContextDimension, x.dim() == dim, || {
+                format!(
+                    "observe returned a context of dimension {} at item {}; context_dim() is {dim}",
+                    x.dim(),
+                    item.index
+                )
+            })?;
             let best = env.best_action();
+            c.check(
+                Check::BestActionInRange,
+                best.is_none_or(|b| b.0 < n_arms),
+                || format!("best_action() = {best:?}, but the action space has arms 0..{n_arms}"),
+            )?;
             let arm = ArmId(rng.random_range(0..n_arms));
-            let out = env.execute(arm)?;
-            let ok = x.dim() == dim
-                && best.is_none_or(|b| b.0 < n_arms)
-                && out
-                    .success_probability
-                    .is_none_or(|p| (0.0..=1.0).contains(&p));
-            if !ok {
-                return Err(crate::HilError::state(
-                    env.name(),
+            let out = c.ok(Check::EpisodeRuns, env.execute(arm))?;
+            c.check(
+                Check::SuccessProbability,
+                out.success_probability
+                    .is_none_or(|p| (0.0..=1.0).contains(&p)),
+                || {
                     format!(
-                        "bad step: context dimension {} (declared {dim}), best action {best:?} of {n_arms}, success probability {:?}",
-                        x.dim(),
+                        "execute({arm:?}) reported success probability {:?}",
                         out.success_probability
-                    ),
-                ));
-            }
+                    )
+                },
+            )?;
             let success = out.success;
             steps.push((x, best, out));
             if success {
@@ -124,5 +247,6 @@ fn run(
         }
         trace.push((item, steps));
     }
+    c.check(Check::EpisodesEnd, true, String::new)?;
     Ok(trace)
 }

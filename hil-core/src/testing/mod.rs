@@ -3,9 +3,18 @@
 //! Like Gymnasium's `check_env`, every implementation of a hil trait (built
 //! in or from a plugin) is run through the same suite:
 //! [`check_policy`], [`check_environment`], [`check_workload_model`],
-//! [`check_query_channel`]. Each returns a [`ConformanceReport`] listing what
-//! was checked and what was skipped (e.g. checkpointing for a policy that
-//! does not support it), or the first [`ConformanceFailure`].
+//! [`check_query_channel`] (and their `_with` forms taking [`CheckOptions`]).
+//! Each returns a [`ConformanceReport`] listing what was checked and what was
+//! skipped (only checkpointing, for a policy whose fresh instance says it
+//! cannot), or the first [`ConformanceFailure`], which names the [`Check`],
+//! what was observed, and the likely cause and fix.
+//!
+//! The suites are strict: a refusal must be the error kind the contract
+//! names (a dimension mismatch, an arm out of range, a call out of order),
+//! and a panic (which a plugin's guard turns into [`HilError::Plugin`]) is a
+//! failure, never a refusal. [`crate::conformance_tests!`] expands into one
+//! `#[test]` per property, so a failing test names the property;
+//! [`broken`] holds a deliberately broken implementation for every check.
 //!
 //! [`fixtures`] has small, real implementations of the traits for tests of
 //! code that consumes them (session loop, logs, metrics; the channel to use
@@ -14,29 +23,41 @@
 //! positive-definite matrices), and [`cdylib`] builds plugin libraries
 //! from tests.
 
+pub mod broken;
 pub mod cdylib;
 pub mod fixtures;
 pub mod mutate;
 pub mod strategies;
 
 mod channel;
+mod check;
 mod environment;
+mod generated;
+mod options;
 mod policy;
 mod workload;
 
-pub use channel::check_query_channel;
-pub use environment::check_environment;
-pub use policy::check_policy;
-pub use workload::check_workload_model;
+pub use channel::{check_query_channel, check_query_channel_only, check_query_channel_with};
+pub use check::{Check, Subject};
+pub use environment::{check_environment, check_environment_only, check_environment_with};
+pub use generated::assert_conforms;
+pub use options::CheckOptions;
+pub use policy::{check_policy, check_policy_only, check_policy_with};
+pub use workload::{check_workload_model, check_workload_model_only, check_workload_model_with};
+
+use crate::HilError;
 
 /// A conformance check that failed.
+///
+/// Match on [`ConformanceFailure::check`]; the message adds what was
+/// observed and [`Check::hint`] (the likely cause and the fix).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("conformance check `{check}` failed for `{subject}`: {detail}")]
+#[error("conformance check `{check}` failed for `{subject}`: {detail}\n  likely cause and fix: {}", check.hint())]
 pub struct ConformanceFailure {
     /// The implementation under test.
     pub subject: String,
     /// The check that failed.
-    pub check: &'static str,
+    pub check: Check,
     /// What was observed.
     pub detail: String,
 }
@@ -47,31 +68,55 @@ pub struct ConformanceReport {
     /// The implementation under test.
     pub subject: String,
     /// Checks that passed.
-    pub passed: Vec<&'static str>,
+    pub passed: Vec<Check>,
     /// Checks that did not apply, with the reason.
-    pub skipped: Vec<(&'static str, String)>,
+    pub skipped: Vec<(Check, String)>,
 }
 
+impl ConformanceReport {
+    /// The names of the checks that passed, comma-separated.
+    pub fn passed_names(&self) -> String {
+        self.passed
+            .iter()
+            .map(|c| c.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// Records the outcome of the checks of one run. When the run is limited
+/// to one property (`only`), every other non-prerequisite check is neither
+/// enforced nor recorded, and scenarios skip the calls only they need.
 pub(crate) struct Checker {
     report: ConformanceReport,
+    only: Option<Check>,
 }
 
 impl Checker {
-    pub(crate) fn new(subject: &str) -> Self {
+    pub(crate) fn new(subject: &str, only: Option<Check>) -> Self {
         Self {
             report: ConformanceReport {
                 subject: subject.to_string(),
                 ..Default::default()
             },
+            only,
         }
+    }
+
+    /// Whether `check` is part of this run.
+    pub(crate) fn wants(&self, check: Check) -> bool {
+        check.is_prerequisite() || self.only.is_none_or(|o| o == check)
     }
 
     pub(crate) fn check(
         &mut self,
-        check: &'static str,
+        check: Check,
         ok: bool,
         detail: impl FnOnce() -> String,
     ) -> Result<(), ConformanceFailure> {
+        if !self.wants(check) {
+            return Ok(());
+        }
         if ok {
             if !self.report.passed.contains(&check) {
                 self.report.passed.push(check);
@@ -82,7 +127,7 @@ impl Checker {
         }
     }
 
-    pub(crate) fn fail(&self, check: &'static str, detail: String) -> ConformanceFailure {
+    pub(crate) fn fail(&self, check: Check, detail: String) -> ConformanceFailure {
         ConformanceFailure {
             subject: self.report.subject.clone(),
             check,
@@ -90,21 +135,68 @@ impl Checker {
         }
     }
 
-    /// Unwraps `r`, turning an error into a failure of `check`.
-    pub(crate) fn ok<T>(
-        &self,
-        check: &'static str,
-        r: crate::Result<T>,
-    ) -> Result<T, ConformanceFailure> {
-        r.map_err(|e| self.fail(check, format!("unexpected error: {e}")))
+    /// Unwraps `r`, turning an error into a failure of `check`. A guarded
+    /// panic ([`HilError::Plugin`]) is called a panic, so it is never
+    /// mistaken for a refusal.
+    pub(crate) fn ok<T>(&self, check: Check, r: crate::Result<T>) -> Result<T, ConformanceFailure> {
+        r.map_err(|e| self.fail(check, describe_error(&e)))
     }
 
-    pub(crate) fn skip(&mut self, check: &'static str, why: String) {
-        self.report.skipped.push((check, why));
+    /// Checks that `r` is an error for which `expected` holds; `call` says
+    /// what was called with what, `kind` names the expected variant.
+    pub(crate) fn refused<T: std::fmt::Debug>(
+        &mut self,
+        check: Check,
+        call: &str,
+        kind: &str,
+        r: crate::Result<T>,
+        expected: impl FnOnce(&HilError) -> bool,
+    ) -> Result<(), ConformanceFailure> {
+        if !self.wants(check) {
+            return Ok(());
+        }
+        let detail = match &r {
+            Err(e) if expected(e) => return self.check(check, true, String::new),
+            Ok(v) => format!("{call} was accepted (returned {v:?}); expected {kind}"),
+            Err(e @ HilError::Plugin { .. }) => {
+                format!("{call} panicked instead of returning {kind}: {e}")
+            }
+            Err(e) => format!("{call} returned the wrong error: {e:?}; expected {kind}"),
+        };
+        Err(self.fail(check, detail))
+    }
+
+    pub(crate) fn skip(&mut self, check: Check, why: String) {
+        if self.wants(check) {
+            self.report.skipped.push((check, why));
+        }
     }
 
     pub(crate) fn finish(self) -> ConformanceReport {
         self.report
+    }
+}
+
+/// Where the panic guard says an object under test came from.
+fn under_test() -> std::path::PathBuf {
+    std::path::PathBuf::from("<object under test>")
+}
+
+/// Runs `make`'s objects under the plugin panic guard (again, for a
+/// plugin's), so a panic in a method is reported as a failure of the check
+/// that called it instead of unwinding through the suite.
+pub(crate) fn guarded<T: ?Sized>(
+    make: &dyn Fn() -> crate::Result<Box<T>>,
+    wrap: impl Fn(Box<T>, std::path::PathBuf) -> crate::Result<Box<T>>,
+) -> impl Fn() -> crate::Result<Box<T>> {
+    move || wrap(make()?, under_test())
+}
+
+/// An error as a failure's detail: a guarded panic is named as one.
+fn describe_error(e: &HilError) -> String {
+    match e {
+        HilError::Plugin { .. } => format!("it panicked (the plugin guard reported: {e})"),
+        _ => format!("unexpected error: {e}"),
     }
 }
 

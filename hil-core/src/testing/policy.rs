@@ -1,185 +1,358 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::fixtures::CountingWorkload;
-use super::{Checker, ConformanceFailure, ConformanceReport, random_context};
+use super::{Check, CheckOptions, Checker, ConformanceFailure, ConformanceReport, random_context};
 use crate::{
-    ArmId, Choice, Context, Decision, DecisionInput, Feedback, Policy, QueryHistory,
-    WorkloadForecast, WorkloadModel,
+    ActionSpace, ArmId, Choice, Context, Decision, DecisionInput, Feedback, HilError, Policy,
+    QueryHistory, Timestep, WorkloadForecast, WorkloadModel,
 };
 
-/// Runs the policy conformance suite on policies built by `make`.
+type Make<'a> = &'a dyn Fn() -> crate::Result<Box<dyn Policy>>;
+
+/// Runs the policy conformance suite on policies built by `make`, with
+/// options taken from the first instance's shape (its arms and dimension);
+/// see [`check_policy_with`] for the checks.
+pub fn check_policy(make: Make<'_>) -> Result<ConformanceReport, ConformanceFailure> {
+    let probe = make().map_err(|e| build_failure(&e))?;
+    let (n_arms, dim) = (probe.n_arms(), probe.dim());
+    let names: Vec<String> = (0..n_arms).map(|i| format!("arm{i}")).collect();
+    let Ok(actions) = ActionSpace::new(names) else {
+        return Err(ConformanceFailure {
+            subject: probe.name().to_string(),
+            check: Check::PolicyShape,
+            detail: format!("n_arms = {n_arms}, dim = {dim}"),
+        });
+    };
+    let opts = CheckOptions::default()
+        .with_actions(actions)
+        .with_context_dim(dim.max(1));
+    check_policy_with(make, &opts)
+}
+
+/// Runs every policy property on policies built by `make` (a factory that
+/// should build for `opts.build_context()`), stopping at the first failure.
 ///
-/// Checks: decisions index the arms; diagnostics are finite; two instances
-/// seeded alike decide alike; a context of the wrong dimension and an arm
-/// out of range are errors, not panics; a checkpoint restored into a fresh
-/// instance continues identically (skipped if the policy cannot checkpoint).
-pub fn check_policy(
-    make: &dyn Fn() -> crate::Result<Box<dyn Policy>>,
+/// Properties, each on fresh instances: [`Check::PolicyShape`] (the shape
+/// is the options' action space and context dimension),
+/// [`Check::ArmInRange`], [`Check::FiniteDiagnostics`],
+/// [`Check::DiagnosticsCoverArms`], [`Check::Determinism`] (two instances
+/// seeded alike, driven in lockstep), [`Check::RejectsWrongDimension`] (a
+/// longer and a shorter context, to `decide` and `observe`, refused with
+/// [`HilError::DimensionMismatch`]), [`Check::RejectsArmOutOfRange`]
+/// ([`HilError::ArmOutOfRange`]), [`Check::RejectionHasNoEffect`] (after
+/// the refusals the policy still decides like its untouched twin) and
+/// [`Check::Checkpoint`] (skipped only when a fresh instance's `save`
+/// returns [`HilError::State`], the trait's "cannot checkpoint").
+pub fn check_policy_with(
+    make: Make<'_>,
+    opts: &CheckOptions,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    let mut a = make().map_err(|e| fail_build(e.to_string()))?;
-    let mut c = Checker::new(a.name());
-    let mut b = c.ok("build", make())?;
-    let (n_arms, dim) = (a.n_arms(), a.dim());
-    c.check("shape", n_arms >= 1 && dim >= 1, || {
-        format!("n_arms = {n_arms}, dim = {dim}")
-    })?;
-    c.check("shape", b.n_arms() == n_arms && b.dim() == dim, || {
-        "two instances from the same factory disagree on their shape".into()
-    })?;
-    a.seed(42);
-    b.seed(42);
-    let model = CountingWorkload::new(0.1);
+    run(make, opts, None)
+}
+
+/// Runs one policy property alone (see [`check_policy_with`]); what
+/// [`crate::conformance_tests!`] calls for each generated test.
+pub fn check_policy_only(
+    make: Make<'_>,
+    opts: &CheckOptions,
+    property: Check,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    run(make, opts, Some(property))
+}
+
+fn build_failure(e: &HilError) -> ConformanceFailure {
+    ConformanceFailure {
+        subject: "<policy factory>".into(),
+        check: Check::Build,
+        detail: e.to_string(),
+    }
+}
+
+fn run(
+    make: Make<'_>,
+    opts: &CheckOptions,
+    only: Option<Check>,
+) -> Result<ConformanceReport, ConformanceFailure> {
+    let make = &super::guarded(make, |o, lib| {
+        let name = o.name().to_string();
+        Ok(Box::new(crate::plugin::GuardedPolicy::new(o, lib, &name)?) as Box<dyn Policy>)
+    });
+    opts.validate().map_err(|e| build_failure(&e))?;
+    let first = make().map_err(|e| build_failure(&e))?;
+    let mut c = Checker::new(first.name(), only);
+    drop(first);
+    let build = |c: &Checker| c.ok(Check::Build, make());
+
+    // Shape.
+    if c.wants(Check::PolicyShape) {
+        let (a, b) = (build(&c)?, build(&c)?);
+        let (n_arms, dim) = (a.n_arms(), a.dim());
+        c.check(Check::PolicyShape, n_arms >= 1 && dim >= 1, || {
+            format!("n_arms = {n_arms}, dim = {dim}")
+        })?;
+        let (want_arms, want_dim) = (opts.actions().len(), opts.context_dim());
+        c.check(
+            Check::PolicyShape,
+            n_arms == want_arms && dim == want_dim,
+            || {
+                format!(
+                    "built with {n_arms} arms and dimension {dim}, but the build context offered {want_arms} arms and dimension {want_dim}"
+                )
+            },
+        )?;
+        c.check(
+            Check::PolicyShape,
+            b.n_arms() == n_arms && b.dim() == dim,
+            || "two instances from the same factory disagree on their shape".into(),
+        )?;
+    }
+
     let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let mut twin_a = Twin::default();
-    let mut twin_b = Twin::default();
-    lockstep(
-        &mut c,
-        "determinism",
-        (a.as_mut(), &mut twin_a),
-        (b.as_mut(), &mut twin_b),
-        &model,
-        &mut rng,
-        40,
-    )?;
-    let (history, state) = (&twin_a.history, &twin_a.state);
 
-    // Bad input.
-    let wrong = Context::new(vec![0.5; dim + 1]).expect("finite");
-    let input = DecisionInput {
-        context: &wrong,
-        t: state.t + 1,
-        item_index: state.item,
-        items_seen: state.item,
-        attempt: 0,
-        workload: WorkloadForecast::new(Some(&model), 0.5, history, state.t + 1),
-    };
-    c.check("rejects wrong dimension", a.decide(&input).is_err(), || {
-        format!(
-            "decide accepted a context of dimension {} (policy has {dim})",
-            dim + 1
-        )
-    })?;
-    let fb = Feedback {
-        context: &wrong,
-        arm: ArmId(0),
-        reward: 1.0,
-        t: state.t + 1,
-        from_expert: false,
-    };
-    c.check("rejects wrong dimension", a.observe(&fb).is_err(), || {
-        "observe accepted a context of the wrong dimension".into()
-    })?;
-    let x = random_context(&mut rng, dim);
-    let fb = Feedback {
-        context: &x,
-        arm: ArmId(n_arms),
-        reward: 1.0,
-        t: state.t + 1,
-        from_expert: false,
-    };
-    c.check("rejects arm out of range", a.observe(&fb).is_err(), || {
-        format!("observe accepted arm {n_arms} of {n_arms}")
-    })?;
+    // Well-formed, deterministic decisions.
+    let lockstep_checks = [
+        Check::ArmInRange,
+        Check::FiniteDiagnostics,
+        Check::DiagnosticsCoverArms,
+        Check::Determinism,
+    ];
+    if lockstep_checks.iter().any(|&k| c.wants(k)) {
+        let (mut a, mut b) = (build(&c)?, build(&c)?);
+        a.seed(42);
+        b.seed(42);
+        let mut pair = Pair::new(a.as_mut(), b.as_mut());
+        pair.run(
+            &mut c,
+            opts,
+            &mut rng,
+            opts.steps(),
+            Some(Check::Determinism),
+            Check::PolicyDecides,
+        )?;
+    }
 
-    // Checkpoint and restore.
-    match a.save() {
-        Err(e) => c.skip("checkpoint", e.to_string()),
-        Ok(state_json) => {
-            let mut r = c.ok("checkpoint", make())?;
-            r.seed(1234); // the restored RNG state must override this
-            c.ok("checkpoint", r.restore(state_json))?;
-            let mut twin_r = twin_a.clone();
-            lockstep(
-                &mut c,
-                "checkpoint",
-                (a.as_mut(), &mut twin_a),
-                (r.as_mut(), &mut twin_r),
-                &model,
-                &mut rng,
-                20,
+    // Bad input: refused with the right kind, and without side effects.
+    for kind in [Check::RejectsWrongDimension, Check::RejectsArmOutOfRange] {
+        if !(c.wants(kind) || c.wants(Check::RejectionHasNoEffect)) {
+            continue;
+        }
+        let (mut a, mut b) = (build(&c)?, build(&c)?);
+        a.seed(42);
+        b.seed(42);
+        let mut pair = Pair::new(a.as_mut(), b.as_mut());
+        pair.run(&mut c, opts, &mut rng, 10, None, Check::PolicyDecides)?;
+        let (t, item) = (pair.ta.t + 1, pair.ta.item);
+        let p = &mut *pair.a;
+        let (n_arms, dim) = (p.n_arms(), p.dim());
+        if kind == Check::RejectsWrongDimension {
+            let mut wrong = vec![dim + 1];
+            if dim > 1 {
+                wrong.push(dim - 1);
+            }
+            for got in wrong {
+                let x = Context::new(vec![0.5; got]).expect("finite");
+                let is_mismatch = |e: &HilError| matches!(e, HilError::DimensionMismatch { expected, got: g } if *expected == dim && *g == got);
+                let kind_name =
+                    format!("HilError::DimensionMismatch {{ expected: {dim}, got: {got} }}");
+                let r = p.decide(&decision_input(
+                    &x,
+                    t,
+                    item,
+                    0,
+                    opts.workload(),
+                    &pair.ta.history,
+                ));
+                c.refused(
+                    kind,
+                    &format!("decide with a context of dimension {got} (policy has {dim})"),
+                    &kind_name,
+                    r,
+                    is_mismatch,
+                )?;
+                let r = p.observe(&feedback(&x, ArmId(0), 1.0, t, false));
+                c.refused(
+                    kind,
+                    &format!("observe with a context of dimension {got} (policy has {dim})"),
+                    &kind_name,
+                    r,
+                    is_mismatch,
+                )?;
+            }
+        } else {
+            let x = random_context(&mut rng, dim);
+            let r = p.observe(&feedback(&x, ArmId(n_arms), 1.0, t, false));
+            c.refused(
+                kind,
+                &format!("observe with arm {n_arms} (the policy has arms 0..{n_arms})"),
+                &format!("HilError::ArmOutOfRange {{ arm: {n_arms}, n_arms: {n_arms} }}"),
+                r,
+                |e| matches!(e, HilError::ArmOutOfRange { arm, n_arms: n } if *arm == n_arms && *n == n_arms),
             )?;
         }
+        if c.wants(Check::RejectionHasNoEffect) {
+            pair.run(
+                &mut c,
+                opts,
+                &mut rng,
+                20,
+                Some(Check::RejectionHasNoEffect),
+                Check::RejectionHasNoEffect,
+            )?;
+        }
+    }
+
+    // Checkpoint and restore.
+    if c.wants(Check::Checkpoint) {
+        let mut a = build(&c)?;
+        a.seed(42);
+        match a.save() {
+            Err(e @ HilError::State { .. }) => {
+                c.skip(Check::Checkpoint, e.to_string());
+                return Ok(c.finish());
+            }
+            Err(e) => {
+                return Err(c.fail(
+                    Check::Checkpoint,
+                    format!(
+                        "save() on a fresh instance failed: {}; a policy that cannot checkpoint returns HilError::State (the trait's default)",
+                        super::describe_error(&e)
+                    ),
+                ));
+            }
+            Ok(_) => {}
+        }
+        let half = (opts.steps() / 2).max(1);
+        let mut ta = Twin::default();
+        for _ in 0..half {
+            let x = random_context(&mut rng, a.dim());
+            let reward = f64::from(rng.random_bool(0.5));
+            drive(
+                &mut c,
+                a.as_mut(),
+                &x,
+                opts.workload(),
+                &mut ta,
+                reward,
+                Check::PolicyDecides,
+            )?;
+        }
+        let state = c.ok(Check::Checkpoint, a.save())?;
+        let mut r = build(&c)?;
+        r.seed(1234); // the restored RNG state must override this
+        c.ok(Check::Checkpoint, r.restore(state))?;
+        let mut pair = Pair {
+            a: a.as_mut(),
+            b: r.as_mut(),
+            tb: ta.clone(),
+            ta,
+        };
+        pair.run(
+            &mut c,
+            opts,
+            &mut rng,
+            half,
+            Some(Check::Checkpoint),
+            Check::Checkpoint,
+        )?;
     }
     Ok(c.finish())
 }
 
-fn fail_build(why: String) -> ConformanceFailure {
-    ConformanceFailure {
-        subject: "<policy factory>".into(),
-        check: "build",
-        detail: why,
+/// The one place the suite builds a [`DecisionInput`].
+fn decision_input<'a>(
+    x: &'a Context,
+    t: Timestep,
+    item: usize,
+    attempt: u32,
+    model: &'a dyn WorkloadModel,
+    history: &'a QueryHistory,
+) -> DecisionInput<'a> {
+    DecisionInput {
+        context: x,
+        t,
+        item_index: item,
+        items_seen: item,
+        attempt,
+        workload: WorkloadForecast::new(Some(model), 0.5, history, t),
     }
 }
 
-/// Drives two policies with identical inputs and checks they decide alike.
-fn lockstep(
-    c: &mut Checker,
-    check: &'static str,
-    (a, ta): (&mut dyn Policy, &mut Twin),
-    (b, tb): (&mut dyn Policy, &mut Twin),
-    model: &dyn WorkloadModel,
-    rng: &mut ChaCha8Rng,
-    steps: usize,
-) -> Result<(), ConformanceFailure> {
-    for _ in 0..steps {
-        let dim = a.dim();
-        let x = random_context(rng, dim);
-        let reward = f64::from(rng.random_bool(0.5));
-        let da = drive(
-            c,
+/// The one place the suite builds a [`Feedback`].
+fn feedback(x: &Context, arm: ArmId, reward: f64, t: Timestep, from_expert: bool) -> Feedback<'_> {
+    Feedback {
+        context: x,
+        arm,
+        reward,
+        t,
+        from_expert,
+    }
+}
+
+/// Two policies fed identical inputs, with the inputs each has seen.
+struct Pair<'p> {
+    a: &'p mut dyn Policy,
+    b: &'p mut dyn Policy,
+    ta: Twin,
+    tb: Twin,
+}
+
+impl<'p> Pair<'p> {
+    fn new(a: &'p mut dyn Policy, b: &'p mut dyn Policy) -> Self {
+        Self {
             a,
-            &x,
-            model,
-            &mut ta.history,
-            &mut ta.state,
-            reward,
-            true,
-        )?;
-        let db = drive(
-            c,
             b,
-            &x,
-            model,
-            &mut tb.history,
-            &mut tb.state,
-            reward,
-            true,
-        )?;
-        c.check(check, da == db, || {
-            format!("same inputs, different decisions: {da:?} vs {db:?}")
-        })?;
+            ta: Twin::default(),
+            tb: Twin::default(),
+        }
     }
-    Ok(())
+
+    /// Drives both for `steps` rounds with the same inputs; with `compare`,
+    /// different decisions fail that check. Errors fail `err`.
+    fn run(
+        &mut self,
+        c: &mut Checker,
+        opts: &CheckOptions,
+        rng: &mut ChaCha8Rng,
+        steps: usize,
+        compare: Option<Check>,
+        err: Check,
+    ) -> Result<(), ConformanceFailure> {
+        for _ in 0..steps {
+            let x = random_context(rng, self.a.dim());
+            let reward = f64::from(rng.random_bool(0.5));
+            let da = drive(c, self.a, &x, opts.workload(), &mut self.ta, reward, err)?;
+            let db = drive(c, self.b, &x, opts.workload(), &mut self.tb, reward, err)?;
+            if let Some(check) = compare {
+                c.check(check, da == db, || {
+                    format!(
+                        "same seed and inputs, different decisions at t = {}: {da:?} vs {db:?}",
+                        self.ta.t
+                    )
+                })?;
+            }
+        }
+        Ok(())
+    }
 }
 
-/// The inputs one policy of a lockstep pair has seen.
+/// The inputs one policy has seen.
 #[derive(Clone, Default)]
 struct Twin {
     history: QueryHistory,
-    state: DriveState,
-}
-
-#[derive(Clone, Default)]
-struct DriveState {
-    t: u64,
+    t: Timestep,
     item: usize,
     attempt: u32,
 }
 
-/// One decide/observe round at the next timestep. Time and history advance
-/// only when `advance` is set, so both twins of a determinism pair see the
-/// same inputs.
-#[allow(clippy::too_many_arguments)]
+/// One decide/observe round at the next timestep; checks the decision.
 fn drive(
     c: &mut Checker,
     p: &mut dyn Policy,
     x: &Context,
     model: &dyn WorkloadModel,
-    history: &mut QueryHistory,
-    s: &mut DriveState,
+    s: &mut Twin,
     reward: f64,
-    advance: bool,
+    err: Check,
 ) -> Result<Decision, ConformanceFailure> {
     let t = s.t + 1;
     // Three attempts per item, so first-attempt rules (ExpDecay) are exercised.
@@ -190,23 +363,26 @@ fn drive(
     } else {
         (s.item, s.attempt + 1)
     };
-    let input = DecisionInput {
-        context: x,
-        t,
-        item_index: item,
-        items_seen: item,
-        attempt,
-        workload: WorkloadForecast::new(Some(model), 0.5, history, t),
-    };
-    let d = c.ok("decide", p.decide(&input))?;
+    let d = c.ok(
+        err,
+        p.decide(&decision_input(x, t, item, attempt, model, &s.history)),
+    )?;
     let n = p.n_arms();
     let arm = match d.choice {
         Choice::Act { arm } => arm,
         Choice::Query { fallback, .. } => fallback,
     };
-    c.check("arm in range", arm.0 < n, || {
-        format!("arm {} of {n}", arm.0)
+    c.check(Check::ArmInRange, arm.0 < n, || {
+        format!(
+            "decide returned arm {} at t = {t}, but the policy has arms 0..{n}",
+            arm.0
+        )
     })?;
+    if arm.0 >= n {
+        // Only reached when this property is not being checked: feeding
+        // the bad arm back would fail an unrelated check.
+        return Err(c.fail(err, format!("decide returned arm {} of {n}", arm.0)));
+    }
     let diag = &d.diagnostics;
     let finite = diag.arms.iter().all(|a| {
         a.estimate.is_finite() && a.bonus.is_finite() && a.ucb.is_finite() && a.bonus >= 0.0
@@ -218,28 +394,21 @@ fn drive(
     ]
     .iter()
     .all(|v| v.is_none_or(f64::is_finite));
-    c.check("finite diagnostics", finite, || format!("{diag:?}"))?;
+    c.check(Check::FiniteDiagnostics, finite, || {
+        format!("at t = {t}: {diag:?}")
+    })?;
     c.check(
-        "diagnostics cover every arm",
+        Check::DiagnosticsCoverArms,
         diag.arms.is_empty() || diag.arms.len() == n,
         || format!("{} entries for {n} arms", diag.arms.len()),
     )?;
     let queried = matches!(d.choice, Choice::Query { .. });
-    c.ok(
-        "observe",
-        p.observe(&Feedback {
-            context: x,
-            arm,
-            reward,
-            t,
-            from_expert: queried,
-        }),
-    )?;
-    if advance {
-        if let Choice::Query { kind, .. } = d.choice {
-            c.ok("decide", history.push(t, kind))?;
-        }
-        *s = DriveState { t, item, attempt };
+    c.ok(err, p.observe(&feedback(x, arm, reward, t, queried)))?;
+    if let Choice::Query { kind, .. } = d.choice {
+        c.ok(err, s.history.push(t, kind))?;
     }
+    s.t = t;
+    s.item = item;
+    s.attempt = attempt;
     Ok(d)
 }

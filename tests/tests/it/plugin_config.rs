@@ -1,7 +1,7 @@
 //! Plugin types in experiment configs: named like built-in types, loaded
 //! before the components are parsed, with located errors.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
@@ -61,6 +61,7 @@ fn all() -> Vec<String> {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn an_experiment_made_only_of_plugins_builds_and_runs() {
     let text = experiment(&all());
     let cfg = ExperimentConfig::parse(&text, Path::new("exp.toml")).unwrap();
@@ -87,6 +88,7 @@ fn an_experiment_made_only_of_plugins_builds_and_runs() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn plugin_paths_are_relative_to_the_config_file() {
     let lib = common::lib("hil-example-env-grasp");
     let name = lib.file_name().unwrap().to_string_lossy().into_owned();
@@ -97,6 +99,7 @@ fn plugin_paths_are_relative_to_the_config_file() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_missing_plugin_is_located_in_the_config() {
     let mut plugins = all();
     plugins.push("plugins/libmissing.so".into());
@@ -109,6 +112,7 @@ fn a_missing_plugin_is_located_in_the_config() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn an_unknown_type_suggests_plugin_names_at_its_line() {
     let text = experiment(&all()).replace("\"linear_thompson\"", "\"linear_thomson\"");
     let e = ExperimentConfig::parse(&text, Path::new("exp.toml")).unwrap_err();
@@ -121,6 +125,7 @@ fn an_unknown_type_suggests_plugin_names_at_its_line() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_plugin_rejecting_its_parameters_names_the_type_and_the_field() {
     let text = experiment(&all()).replace("tau = 18.0", "tau = -1.0");
     let cfg = ExperimentConfig::parse(&text, Path::new("exp.toml")).unwrap();
@@ -138,6 +143,7 @@ fn a_plugin_rejecting_its_parameters_names_the_type_and_the_field() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn the_explicit_plugin_form_and_serialisation_round_trip() {
     let text = experiment(&all()).replace(
         "type = \"noisy_expert\"\nerror = 0.2",

@@ -12,6 +12,7 @@ use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
 use hil_core::{BuildContext, HilError};
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn every_kind_of_object_reports_a_destructor_panic_to_the_host() {
     let krate = "hil-test-plugin-panicky";
     let ws = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
@@ -21,6 +22,7 @@ fn every_kind_of_object_reports_a_destructor_panic_to_the_host() {
     let actions = hil_core::ActionSpace::new(["a", "b"]).unwrap();
     let task = hil_core::TaskContext::new(ctx.clone(), actions, 4);
     let p = Params::toml("panic_in = \"drop\"");
+    let _lock = crate::common::destructor_panics_lock();
     assert!(plugin::take_destructor_panics().is_empty());
 
     drop(plugin::build_policy("panicky_policy", &p, &task).unwrap());

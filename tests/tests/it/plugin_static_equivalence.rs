@@ -2,8 +2,8 @@
 //! identical decisions for the same seed, and checkpoints cross the
 //! boundary both ways.
 
+use crate::common;
 use hil_core::TaskContext;
-mod common;
 
 use std::sync::Arc;
 
@@ -56,6 +56,7 @@ fn episodes(policy: &mut dyn Policy, n: usize) -> Vec<EpisodeReport> {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn static_and_plugin_policies_decide_identically() {
     let info = plugin::load(&common::lib("hil-example-policy-thompson")).unwrap();
     assert_eq!(info.components[0].name, hil_example_policy_thompson::NAME);
@@ -85,11 +86,17 @@ fn static_and_plugin_policies_decide_identically() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn the_static_policy_passes_its_conformance_suite_through_the_plugin_too() {
     plugin::load(&common::lib("hil-example-policy-thompson")).unwrap();
     let report = hil_core::testing::check_policy(&|| {
         plugin::build_policy("linear_thompson", &Params::empty(), &ctx(6))
     })
     .unwrap();
-    assert!(report.passed.contains(&"checkpoint"), "{report:?}");
+    assert!(
+        report
+            .passed
+            .contains(&hil_core::testing::Check::Checkpoint),
+        "{report:?}"
+    );
 }

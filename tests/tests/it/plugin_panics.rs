@@ -2,9 +2,9 @@
 //! is an error (or, for methods that cannot fail, a poisoned object whose
 //! next fallible call is an error), and the host process carries on.
 
+use crate::common;
 use hil_core::TaskContext;
 use hil_core::WorkloadInput;
-mod common;
 
 use hil_core::plugin::{self, Params};
 use hil_core::{
@@ -77,6 +77,7 @@ fn observe(p: &mut dyn Policy) -> hil_core::Result<()> {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn policy_panics_are_errors() {
     load();
     let build = |m: &str| plugin::build_policy("panicky_policy", &params(m), &task());
@@ -105,10 +106,13 @@ fn policy_panics_are_errors() {
     decide(p.as_mut()).unwrap();
     observe(p.as_mut()).unwrap();
     // Dropping one that panics in its destructor does not take the host down.
+    let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
+    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn environment_panics_are_errors() {
     load();
     let build = |m: &str| plugin::build_environment("panicky_env", &params(m), &ctx());
@@ -145,10 +149,13 @@ fn environment_panics_are_errors() {
     assert_eq!(e.current_item(), Some(&item));
     assert_eq!(e.best_action(), Some(ArmId(1)));
     assert_eq!(e.action_space().len(), 2);
+    let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
+    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn workload_model_panics_are_errors() {
     load();
     let build = |m: &str| plugin::build_workload_model("panicky_workload", &params(m), &ctx());
@@ -167,10 +174,13 @@ fn workload_model_panics_are_errors() {
         m.predict_if_queried(&WorkloadInput::new(0.5, &h, 1), QueryKind::default()),
         "predict_if_queried",
     );
+    let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
+    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn query_channel_panics_are_errors() {
     load();
     let build = |m: &str| plugin::build_query_channel("panicky_channel", &params(m), &task());
@@ -192,7 +202,9 @@ fn query_channel_panics_are_errors() {
     assert_poisoned(c.ask(&q), "seed");
     let mut c = build("").unwrap();
     assert_eq!(c.ask(&q).unwrap().expert_arm, Some(ArmId(0)));
+    let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
+    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]

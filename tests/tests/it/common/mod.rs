@@ -45,3 +45,11 @@ pub fn scratch(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).expect("scratch dir");
     dir
 }
+
+/// Held by every test that drops a plugin object whose destructor panics:
+/// those panics land in one process-wide list
+/// (`plugin::take_destructor_panics`), and the tests share a process.
+pub fn destructor_panics_lock() -> std::sync::MutexGuard<'static, ()> {
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    LOCK.lock().unwrap_or_else(|e| e.into_inner())
+}

@@ -7,6 +7,7 @@ use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
 use hil_experiments::user_study::UserStudyConfig;
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_plugin_channel_answers_the_study() {
     let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()

@@ -1,8 +1,8 @@
 //! Loading plugins: every refusal is a clear error naming the file, and
 //! loading is idempotent.
 
+use crate::common;
 use hil_core::TaskContext;
-mod common;
 
 use std::path::Path;
 
@@ -35,6 +35,7 @@ fn a_missing_file_is_named() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_library_without_a_declaration_is_not_a_plugin() {
     let e = plugin::load(&lib("hil-test-plugin-not-a-plugin")).unwrap_err();
     assert!(why(&e).starts_with("not a hil plugin"), "{e}");
@@ -54,6 +55,7 @@ fn a_file_that_is_not_a_library_is_refused() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn an_abi_mismatch_names_both_versions() {
     let e = plugin::load(&lib("hil-test-plugin-mismatched-abi")).unwrap_err();
     let w = why(&e);
@@ -69,6 +71,7 @@ fn an_abi_mismatch_names_both_versions() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_hil_core_version_mismatch_names_both_versions() {
     let e = plugin::load(&lib("hil-test-plugin-mismatched-version")).unwrap_err();
     let w = why(&e);
@@ -94,6 +97,7 @@ fn a_hil_core_version_mismatch_names_both_versions() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn loading_the_same_library_twice_is_harmless() {
     let path = lib("hil-example-env-grasp");
     let a = plugin::load(&path).unwrap();
@@ -114,6 +118,7 @@ fn loading_the_same_library_twice_is_harmless() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_duplicate_name_is_refused_naming_the_first_library() {
     let original = lib("hil-example-workload-fatigue");
     let first = plugin::load(&original).unwrap();
@@ -129,6 +134,7 @@ fn a_duplicate_name_is_refused_naming_the_first_library() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn an_unknown_name_lists_the_closest_registered_names() {
     plugin::load(&lib("hil-example-policy-thompson")).unwrap();
     let e = plugin::build_policy("linear_thomson", &Params::empty(), &task())
@@ -140,6 +146,7 @@ fn an_unknown_name_lists_the_closest_registered_names() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn a_factory_rejecting_its_parameters_says_which_and_why() {
     let info = plugin::load(&lib("hil-example-policy-thompson")).unwrap();
     let e = plugin::build_policy("linear_thompson", &Params::toml("v = -1.0"), &task())
@@ -163,6 +170,7 @@ fn a_factory_rejecting_its_parameters_says_which_and_why() {
 }
 
 #[test]
+#[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn list_reports_the_build_facts() {
     let info = plugin::load(&lib("hil-example-channel-noisy-expert")).unwrap();
     assert_eq!(info.abi_version, plugin::ABI_VERSION);

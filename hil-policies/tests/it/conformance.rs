@@ -78,7 +78,11 @@ fn conformance_suite_passes_for_every_policy_and_representation() {
         for make in all_policies(r) {
             let report = check_policy(&*make).unwrap_or_else(|e| panic!("{r:?}: {e}"));
             assert!(report.skipped.is_empty(), "{report:?}");
-            assert!(report.passed.contains(&"checkpoint"));
+            assert!(
+                report
+                    .passed
+                    .contains(&hil_core::testing::Check::Checkpoint)
+            );
         }
     }
 }

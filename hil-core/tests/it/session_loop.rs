@@ -299,7 +299,7 @@ fn fixtures_pass_their_conformance_suites() {
         4,
     )
     .unwrap();
-    assert!(r.passed.contains(&"replayable"));
+    assert!(r.passed.contains(&Check::Replayable));
     let r = check_policy(&|| {
         Ok(Box::new(ScriptedPolicy::new(
             3,
@@ -308,7 +308,7 @@ fn fixtures_pass_their_conformance_suites() {
         )))
     })
     .unwrap();
-    assert!(r.passed.contains(&"checkpoint"), "{r:?}");
+    assert!(r.passed.contains(&Check::Checkpoint), "{r:?}");
     check_workload_model(&CountingWorkload::new(0.05)).unwrap();
     check_query_channel(&mut PerfectExpert::default(), 20).unwrap();
 }
@@ -355,7 +355,7 @@ fn conformance_catches_a_broken_environment() {
         3,
     )
     .unwrap_err();
-    assert_eq!(err.check, "replayable");
+    assert_eq!(err.check, hil_core::testing::Check::Replayable);
 }
 
 /// A model whose workload decays: each query adds 0.3, forgotten 2 steps

@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use hil_core::{HilError, Result};
 use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyResult};
 use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
+use hil_kinova_mujoco::controller::RollBy;
 use hil_kinova_mujoco::food::{Label, parse_labels};
 use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
 use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
@@ -58,6 +59,11 @@ pub struct CalibrateArgs {
     /// counts, heights) to this file as JSON lines.
     #[arg(long)]
     pub attempts: Option<PathBuf>,
+    /// What turns the tine row by an action's roll: `fork_gamma` (the
+    /// fork's γ joint about the pitched handle) or `arm_yaw` (the arm turns
+    /// a rigid fork about the vertical, as in the published data set).
+    #[arg(long, default_value = "fork_gamma")]
+    pub roll_by: String,
     /// Print a JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -156,7 +162,15 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             "must be at least 1",
         ));
     }
+    let roll_by = RollBy::parse(&args.roll_by).ok_or_else(|| {
+        HilError::invalid_parameter(
+            "--roll-by",
+            args.roll_by.clone(),
+            "expected fork_gamma or arm_yaw",
+        )
+    })?;
     let opts = CalibrationOptions {
+        roll_by,
         foods: labels_or_all("--foods", &args.foods)?,
         settings: labels_or_all("--settings", &args.settings)?,
         trials: args.trials,
@@ -212,7 +226,7 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     let header = || {
         print!("{:<22}", "food");
         for a in hil_envs::feeding::action_space().names() {
-            print!("{a:>13}");
+            print!("{a:>18}");
         }
         println!();
     };
@@ -220,33 +234,37 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     for chunk in report.rows.chunks(6) {
         print!("{:<22}", chunk[0].food);
         for r in chunk {
-            print!("{:>13}", cell(r.rate, r.published));
+            print!("{:>18}", cell(r.rate, r.se, r.published));
         }
         println!();
         for (i, c) in chunk[0].by_setting.iter().enumerate() {
             print!("{:<22}", format!("  {}", c.setting.name()));
             for r in chunk {
                 let c = &r.by_setting[i];
-                print!("{:>13}", cell(c.rate, c.published));
+                print!("{:>18}", cell(c.rate, c.se, c.published));
             }
             println!();
         }
     }
     println!(
-        "mean |simulated - published| = {:.3} overall, {:.3} per setting; {:.1} attempts/s on {} threads ({:.1} per core); {:.1}% of time outside mj_step",
+        "mean |simulated - published| = {:.3} overall (largest {:.3}), {:.3} per setting; hold {:.1} s; {:.1} attempts/s on {} threads ({:.1} per core); {:.0} steps per attempt at {:.1} µs per mj_step; {:.1}% of time outside mj_step",
         report.mean_abs_error,
+        report.max_abs_error,
         report.mean_abs_error_by_setting,
+        report.hold_s,
         report.attempts_per_second,
         report.threads,
         report.attempts_per_second_per_core,
+        report.steps_per_attempt,
+        report.micros_per_step,
         100.0 * report.overhead_share
     );
     Ok(())
 }
 
-fn cell(rate: f64, published: Option<f64>) -> String {
+fn cell(rate: f64, se: f64, published: Option<f64>) -> String {
     let p = published.map_or("  -  ".into(), |p| format!("{p:.2}"));
-    format!("{rate:.2} ({p})")
+    format!("{rate:.2}±{se:.2} ({p})")
 }
 
 /// What the results are, printed with them.

@@ -27,12 +27,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let r = sim.execute(a, &perceived, None)?;
             println!(
-                "{} {} success={} pitch={:.3} roll={:.3} stop={:?} peak={:.1} tines={:?} h={:.3}",
+                "{} {} success={} pitch={:.3} gamma={:.3} roll={:.3} handle={:.3} stop={:?} peak={:.1} tines={:?} h={:.3}",
                 kind.name(),
                 a.name,
                 r.success,
                 r.reached_pitch,
+                r.reached_gamma,
                 r.reached_roll,
+                r.handle_roll,
                 r.stop,
                 r.peak_force,
                 r.tines,

@@ -37,7 +37,7 @@ use std::time::{Duration, Instant};
 use hil_core::{ArmId, Environment, HilError, Result};
 use serde::Serialize;
 
-use crate::controller::ACTIONS;
+use crate::controller::{ACTIONS, RollBy};
 use crate::env::{KinovaFeedingConfig, KinovaFeedingEnv};
 use crate::food::{FoodKind, Setting};
 use crate::sim::AttemptReport;
@@ -55,6 +55,8 @@ pub struct CalibrationOptions {
     pub seed: u64,
     /// Worker threads (each with its own simulator).
     pub threads: usize,
+    /// What turns the tine row by an action's roll.
+    pub roll_by: RollBy,
 }
 
 impl Default for CalibrationOptions {
@@ -65,6 +67,7 @@ impl Default for CalibrationOptions {
             trials: 30,
             seed: 1,
             threads: 1,
+            roll_by: RollBy::default(),
         }
     }
 }
@@ -80,6 +83,8 @@ pub struct SettingCell {
     pub successes: usize,
     /// Achieved success rate.
     pub rate: f64,
+    /// Binomial standard error of `rate`, √(p(1−p)/n).
+    pub se: f64,
     /// Published rate in this setting.
     pub published: Option<f64>,
 }
@@ -97,6 +102,8 @@ pub struct CalibrationRow {
     pub successes: usize,
     /// Achieved success rate.
     pub rate: f64,
+    /// Binomial standard error of `rate`, √(p(1−p)/n).
+    pub se: f64,
     /// Published rate (setting `all`) when the trials cover all three
     /// settings equally; otherwise the mean of the published rates of the
     /// settings run.
@@ -127,11 +134,25 @@ pub struct CalibrationReport {
     pub rows: Vec<CalibrationRow>,
     /// Mean absolute difference to the published rates (overall rows).
     pub mean_abs_error: f64,
+    /// Largest absolute difference to the published rates (overall rows).
+    pub max_abs_error: f64,
     /// Mean absolute difference per setting cell.
     pub mean_abs_error_by_setting: f64,
+    /// How long an item had to stay on the lifted fork (s).
+    pub hold_s: f64,
+    /// What turned the tine row by the actions' roll.
+    pub roll_by: RollBy,
+    /// Physics steps per attempt (staging and execution), averaged.
+    pub steps_per_attempt: f64,
+    /// CPU time per physics step inside `mj_step` (µs), averaged (the CPU
+    /// time apportioned by the wall-clock share inside `mj_step`): with
+    /// `steps_per_attempt` this bounds the attempts per second per core.
+    pub micros_per_step: f64,
     /// Simulated attempts per wall-clock second, all threads together.
     pub attempts_per_second: f64,
-    /// Simulated attempts per second of one thread's busy time (one core).
+    /// Simulated attempts per second of one core: attempts over the CPU
+    /// time the worker threads spent on them (other programs on the
+    /// machine do not count against it).
     pub attempts_per_second_per_core: f64,
     /// Worker threads used.
     pub threads: usize,
@@ -210,6 +231,7 @@ pub fn calibrate_with(
                 e.insert(KinovaFeedingEnv::new(KinovaFeedingConfig {
                     plate: vec![food.name().to_string()],
                     settings: vec![setting.name().to_string()],
+                    roll_by: opts.roll_by,
                     ..KinovaFeedingConfig::default()
                 })?)
             }
@@ -236,6 +258,9 @@ pub fn calibrate_with(
     let records: Vec<AttemptRecord> =
         pool.install(|| jobs.par_iter().map(attempt).collect::<Result<_>>())?;
     let mut timing = (Duration::ZERO, Duration::ZERO);
+    let mut cpu = Duration::ZERO;
+    let mut steps = 0u64;
+    let mut hold_s = crate::sim::PUBLISHED_HOLD;
     for envs in scenes {
         for env in envs
             .into_inner()
@@ -245,6 +270,9 @@ pub fn calibrate_with(
             let t = env.simulator().timing();
             timing.0 += t.in_step;
             timing.1 += t.total;
+            steps += t.steps;
+            cpu += t.cpu;
+            hold_s = env.simulator().hold();
         }
     }
     let wall = start.elapsed().as_secs_f64();
@@ -254,7 +282,19 @@ pub fn calibrate_with(
     let rows = tabulate(opts, &records);
     let (in_step, busy) = timing;
     let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let max_abs_error = rows
+        .iter()
+        .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
+        .fold(0.0, f64::max);
     Ok(CalibrationReport {
+        max_abs_error,
+        hold_s,
+        roll_by: opts.roll_by,
+        steps_per_attempt: steps as f64 / total.max(1) as f64,
+        micros_per_step: 1e6
+            * cpu.as_secs_f64()
+            * (in_step.as_secs_f64() / busy.as_secs_f64().max(1e-9))
+            / steps.max(1) as f64,
         mean_abs_error: mean(
             rows.iter()
                 .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
@@ -267,12 +307,21 @@ pub fn calibrate_with(
                 .collect(),
         ),
         attempts_per_second: total as f64 / wall.max(1e-9),
-        attempts_per_second_per_core: total as f64 / busy.as_secs_f64().max(1e-9),
+        attempts_per_second_per_core: total as f64 / cpu.as_secs_f64().max(1e-9),
         threads: opts.threads,
         overhead_share: 1.0 - in_step.as_secs_f64() / busy.as_secs_f64().max(1e-9),
         rows,
         note: "simulated (MuJoCo) attempts with synthetic food properties; published rates: Feng et al. 2019 (settings isolated, wall, lettuce; `all` is their mean)",
     })
+}
+
+/// Binomial standard error of a rate of `successes` in `trials`.
+pub fn binomial_se(successes: usize, trials: usize) -> f64 {
+    if trials == 0 {
+        return 0.0;
+    }
+    let p = successes as f64 / trials as f64;
+    (p * (1.0 - p) / trials as f64).sqrt()
 }
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
@@ -302,6 +351,7 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                         trials,
                         successes,
                         rate: successes as f64 / trials.max(1) as f64,
+                        se: binomial_se(successes, trials),
                         published: Some(food.published_rates_in(setting)[a]),
                     }
                 })
@@ -330,6 +380,7 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                 trials,
                 successes,
                 rate: successes as f64 / trials.max(1) as f64,
+                se: binomial_se(successes, trials),
                 published,
                 by_setting,
             });

@@ -3,18 +3,21 @@
 //! An action is a fork pitch β (handle relative to vertical, G21: VS 0, TV
 //! −0.5, TA +0.4 rad), a roll of the tine row relative to the food's
 //! perceived major axis (0 or 90°) and a force threshold (VS 25 N, TV 20 N,
-//! TA 10 N). The arm keeps the fork base pointing straight down, turned
-//! about the vertical so that the tine row makes the commanded roll with the
-//! major axis; the fork's pitch motor sets β and its roll motor holds γ = 0.
-//! The tines curve 0.26 rad towards the fork's +z, so VS tines lean 0.26 rad,
-//! TV tines −0.24 rad (nearly vertical) and TA tines 0.66 rad from vertical.
+//! TA 10 N). The arm holds the fork base (the handle) pointing straight
+//! down, turned about the vertical so that at γ = 0 the tine row lies along
+//! the perceived major axis; the fork's pitch motor sets β and its roll
+//! motor sets γ to the action's roll (0 or 90°), turning the tines about the
+//! pitched handle as the paper's fork does. The tines curve 0.26 rad towards
+//! the fork's +z, so at γ = 0 VS tines lean 0.26 rad, TV tines −0.24 rad
+//! (nearly vertical) and TA tines 0.66 rad from vertical; at γ = 90° the
+//! curve and the pitch lean them in different planes.
 //!
 //! Inverse kinematics runs on a private copy of the model from commanded
 //! joint positions only (what a robot's trajectory generator knows); the
 //! physical arm follows through its joint servos.
 
 use mujoco_rs::prelude::*;
-use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
 
 use crate::error::KinovaError;
 use crate::model::SceneIds;
@@ -72,6 +75,38 @@ pub const ACTIONS: [Action; 6] = [
     },
 ];
 
+/// What turns the tine row by an action's roll.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RollBy {
+    /// The fork's own roll joint γ, about the pitched handle, while the arm
+    /// holds the handle (the paper's 2-DoF fork). At β ≠ 0 this also
+    /// changes the tines' lean and tilts the tine row.
+    #[default]
+    ForkGamma,
+    /// The arm turns the whole fork about the vertical, γ stays 0 (a rigid
+    /// fork, as in the data set the published rates come from): the tines'
+    /// lean is the same at 0° and 90°.
+    ArmYaw,
+}
+
+impl RollBy {
+    /// The label used in configs and flags.
+    pub fn name(self) -> &'static str {
+        match self {
+            RollBy::ForkGamma => "fork_gamma",
+            RollBy::ArmYaw => "arm_yaw",
+        }
+    }
+
+    /// Parses a label (`fork_gamma`, `arm_yaw`).
+    pub fn parse(s: &str) -> Option<Self> {
+        [RollBy::ForkGamma, RollBy::ArmYaw]
+            .into_iter()
+            .find(|r| r.name() == s)
+    }
+}
+
 /// Curvature of the tines towards the fork's +z (rad), from the MJCF.
 pub const TINE_CURVE: f64 = 0.262;
 
@@ -84,12 +119,20 @@ pub fn fork_base_orientation(psi: f64) -> Matrix3<f64> {
     Matrix3::from_columns(&[x, y, z])
 }
 
-/// Direction of the tines (root to tip) for pitch `beta` and row yaw `psi`.
-pub fn tine_direction(beta: f64, psi: f64) -> Vector3<f64> {
-    let r = fork_base_orientation(psi);
-    let a = beta + TINE_CURVE;
-    // Rotating the handle about the pitch axis tilts x towards +z.
-    r * Vector3::new(a.cos(), 0.0, a.sin())
+/// Orientation of the fork's roll link (tines and tine row) for a fork base
+/// at `base`, pitch `beta` and roll `gamma`, as the MJCF's joints turn it:
+/// β about the base's −y, then γ about the pitched handle (x).
+pub fn fork_roll_orientation(base: &Matrix3<f64>, beta: f64, gamma: f64) -> Matrix3<f64> {
+    let pitch = Rotation3::from_axis_angle(&-Vector3::y_axis(), beta);
+    let roll = Rotation3::from_axis_angle(&Vector3::x_axis(), gamma);
+    base * (pitch * roll).matrix()
+}
+
+/// Direction of the tines (root to tip) for a fork base at `base`, pitch
+/// `beta` and roll `gamma`: the fork's x axis bent by the tines' curve
+/// towards its +z.
+pub fn tine_direction(base: &Matrix3<f64>, beta: f64, gamma: f64) -> Vector3<f64> {
+    fork_roll_orientation(base, beta, gamma) * Vector3::new(TINE_CURVE.cos(), 0.0, TINE_CURVE.sin())
 }
 
 /// Kinematics of the arm on a private copy of the model.
@@ -247,4 +290,33 @@ fn clamp_limits(q: &mut [f64; 6]) {
 pub fn min_jerk(t: f64) -> f64 {
     let t = t.clamp(0.0, 1.0);
     t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gamma_turns_the_tines_about_the_pitched_handle() {
+        let base = fork_base_orientation(0.0);
+        // At β = 0 the handle is vertical: rolling by γ is the same as the
+        // arm turning the fork about the vertical (by −γ: γ turns the row's
+        // y towards the fork's z, which points the other way round).
+        let by_gamma = tine_direction(&base, 0.0, FRAC_PI_2);
+        let by_arm = tine_direction(&fork_base_orientation(-FRAC_PI_2), 0.0, 0.0);
+        assert!((by_gamma - by_arm).norm() < 1e-12, "{by_gamma} vs {by_arm}");
+        // Pitched (TV, β = −0.5), γ = 0 leaves the tines nearly vertical;
+        // γ = 90° turns the tines' curve out of the pitch plane, so they
+        // lean by the pitch and the curve together.
+        let lean = |u: Vector3<f64>| u.dot(&-Vector3::z()).acos();
+        let tv0 = tine_direction(&base, -0.5, 0.0);
+        let tv90 = tine_direction(&base, -0.5, FRAC_PI_2);
+        assert!((lean(tv0) - (0.5 - TINE_CURVE)).abs() < 1e-9);
+        let expected = (0.5f64.cos() * TINE_CURVE.cos()).acos();
+        assert!((lean(tv90) - expected).abs() < 1e-9, "{}", lean(tv90));
+        // Both keep unit length.
+        assert!((tv90.norm() - 1.0).abs() < 1e-12);
+    }
+
+    use std::f64::consts::FRAC_PI_2;
 }

@@ -27,11 +27,13 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::controller::ACTIONS;
+use crate::controller::{ACTIONS, RollBy};
 use crate::food::{FoodKind, FoodModel, FoodProps, Setting, parse_labels};
 use crate::model::MjcfSource;
 use crate::perception::{Embedding, Observation, PerceptionNoise, RIM_RADIUS, perceive};
-use crate::sim::{AttemptReport, KeyframeHook, LeafPlacement, Placement, Simulator};
+use crate::sim::{
+    AttemptReport, KeyframeHook, LeafPlacement, PUBLISHED_HOLD, Placement, Simulator,
+};
 
 /// Configuration of [`KinovaFeedingEnv`] (`type = "kinova_feeding"`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -65,6 +67,18 @@ pub struct KinovaFeedingConfig {
     /// (the paper pretrained on other foods, which this scene lacks).
     #[serde(default)]
     pub pretraining_trials: usize,
+    /// How long an item must stay on the lifted fork to count (s); the
+    /// published rule is 5 s.
+    #[serde(default = "default_hold")]
+    pub hold_s: f64,
+    /// What turns the tine row by an action's roll: `fork_gamma` (the
+    /// fork's γ joint, default) or `arm_yaw` (the arm turns a rigid fork).
+    #[serde(default)]
+    pub roll_by: RollBy,
+}
+
+fn default_hold() -> f64 {
+    PUBLISHED_HOLD
 }
 
 fn default_plate() -> Vec<String> {
@@ -91,6 +105,8 @@ impl Default for KinovaFeedingConfig {
             mjcf: None,
             noise: PerceptionNoise::default(),
             pretraining_trials: 0,
+            hold_s: PUBLISHED_HOLD,
+            roll_by: RollBy::default(),
         }
     }
 }
@@ -255,10 +271,14 @@ impl KinovaFeedingEnv {
     /// Builds the environment (loads the MJCF).
     pub fn new(cfg: KinovaFeedingConfig) -> Result<Self> {
         cfg.validate()?;
-        let sim = match &cfg.mjcf {
+        let mut sim = match &cfg.mjcf {
             Some(p) => Simulator::from_source(MjcfSource::File(p))?,
             None => Simulator::new()?,
         };
+        sim.set_hold(cfg.hold_s).map_err(|e| {
+            HilError::invalid_parameter("hold_s", cfg.hold_s.to_string(), e.to_string())
+        })?;
+        sim.set_roll_by(cfg.roll_by);
         Ok(Self {
             foods: cfg.foods()?,
             settings: cfg.parsed_settings()?,

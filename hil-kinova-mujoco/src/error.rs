@@ -58,6 +58,12 @@ pub enum KinovaError {
         /// Remaining pose error (m + rad).
         residual: f64,
     },
+    /// A hold duration outside 0–60 s or not finite.
+    #[error("hold of {seconds} s: must be finite and within 0–60 s")]
+    InvalidHold {
+        /// The value given.
+        seconds: f64,
+    },
 }
 
 impl From<KinovaError> for HilError {

@@ -447,7 +447,7 @@ impl FoodModel {
                 puncture_indent: 0.002,
                 cut_fraction: 0.3,
                 grip_per_m: (0.3, 0.5),
-                friction: (0.9, 0.3),
+                friction: (1.1, 0.3),
                 tear_per_m: (22.0, 0.3),
                 cut_fraction_of_width: 0.3,
             },

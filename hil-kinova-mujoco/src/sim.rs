@@ -8,7 +8,7 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use serde::Serialize;
 
 use crate::controller::{
-    Action, Kinematics, PoseTarget, fork_base_orientation, min_jerk, tine_direction,
+    Action, Kinematics, PoseTarget, RollBy, fork_base_orientation, min_jerk, tine_direction,
 };
 use crate::error::KinovaError;
 use crate::food::{FoodKind, FoodProps, Shape};
@@ -23,12 +23,11 @@ const PRE_OFFSET: f64 = 0.04;
 const DEPTH_LIMIT: f64 = 0.035;
 /// Lift height (m), as ADA's two 0.025 m moves plus margin.
 const LIFT: f64 = 0.06;
-/// How long the item must stay on the fork after the lift (s). The
-/// published rule is 5 s; this model's items creep off slowly, and a 5 s
-/// hold drops many more of them (cantaloupe VS0 0.43 instead of 0.77 over
-/// 30 trials) at half the throughput, so calibration holds 1.5 s (a stated
-/// approximation).
-const HOLD: f64 = 1.5;
+/// Duration of the lift (s): a mean speed of 10 cm/s.
+const LIFT_TIME: f64 = 0.6;
+/// How long the item must stay on the fork after the lift (s): the
+/// published success rule (Feng et al. 2019).
+pub const PUBLISHED_HOLD: f64 = 5.0;
 /// Smallest rotational inertia given to an item (kg·m²).
 const MIN_INERTIA: f64 = 3e-6;
 /// Height of the lettuce leaf's midrib above its blade (m, MJCF).
@@ -105,8 +104,14 @@ pub struct AttemptReport {
     pub success: bool,
     /// Fork pitch reached before the approach (rad).
     pub reached_pitch: f64,
+    /// Fork roll joint γ reached before the approach (rad).
+    pub reached_gamma: f64,
     /// Angle of the tine row to the perceived major axis before the approach (rad, in [0, π/2]).
     pub reached_roll: f64,
+    /// Angle of the fork base's y axis (the handle's roll, set by the arm)
+    /// to the perceived major axis before the approach (rad, in [0, π/2]):
+    /// 0 for every action when γ makes the roll.
+    pub handle_roll: f64,
     /// Why penetration ended.
     pub stop: StopReason,
     /// Largest axial wrist force during penetration (N).
@@ -115,6 +120,11 @@ pub struct AttemptReport {
     pub tines: SkewerStats,
     /// Height of the item above the plate at the end (m).
     pub final_height: f64,
+    /// Height of the item above the plate when the hold began (m).
+    pub lifted_height: f64,
+    /// How far the item slid along the tines during the hold, summed over
+    /// its pierced tines (m).
+    pub hold_slip: f64,
     /// Simulated time (s).
     pub sim_time: f64,
     /// Physics steps taken.
@@ -128,8 +138,13 @@ pub struct Timing {
     pub in_step: Duration,
     /// Total time spent in `stage` and `execute`.
     pub total: Duration,
+    /// CPU time this thread spent in `stage` and `execute`: the busy time
+    /// of one core, unaffected by other programs sharing the machine.
+    pub cpu: Duration,
     /// Attempts executed.
     pub attempts: u64,
+    /// Physics steps taken (staging and attempts).
+    pub steps: u64,
 }
 
 /// Called with a phase name and the physics state at each keyframe.
@@ -147,6 +162,10 @@ pub struct Simulator {
     leaf_under: Option<FoodKind>,
     target: Option<FoodKind>,
     dt: f64,
+    hold: f64,
+    roll_by: RollBy,
+    /// Contact bits of every geom as loaded, to restore parked bodies.
+    contacts0: Vec<(i32, i32)>,
     timing: Timing,
 }
 
@@ -179,6 +198,13 @@ impl Simulator {
         };
         let seed = [0.0, 0.35, -2.0, 0.0, -0.9, std::f64::consts::FRAC_PI_2];
         let home = kin.solve(&seed, [0.0, 0.0], &home_target, "home pose above the plate")?;
+        let m = data.model();
+        let contacts0 = m
+            .geom_contype()
+            .iter()
+            .zip(m.geom_conaffinity())
+            .map(|(&t, &a)| (t, a))
+            .collect();
         Ok(Self {
             data,
             ids,
@@ -189,8 +215,37 @@ impl Simulator {
             leaf_under: None,
             target: None,
             dt,
+            hold: PUBLISHED_HOLD,
+            roll_by: RollBy::default(),
+            contacts0,
             timing: Timing::default(),
         })
+    }
+
+    /// Sets how long an item must stay on the lifted fork (s); the default
+    /// is the published [`PUBLISHED_HOLD`].
+    pub fn set_hold(&mut self, seconds: f64) -> Result<(), KinovaError> {
+        if !(seconds.is_finite() && (0.0..=60.0).contains(&seconds)) {
+            return Err(KinovaError::InvalidHold { seconds });
+        }
+        self.hold = seconds;
+        Ok(())
+    }
+
+    /// How long an item must stay on the lifted fork (s).
+    pub fn hold(&self) -> f64 {
+        self.hold
+    }
+
+    /// Sets what turns the tine row by an action's roll (default: the
+    /// fork's γ joint).
+    pub fn set_roll_by(&mut self, roll_by: RollBy) {
+        self.roll_by = roll_by;
+    }
+
+    /// What turns the tine row by an action's roll.
+    pub fn roll_by(&self) -> RollBy {
+        self.roll_by
     }
 
     /// Arm joint angles of the home pose.
@@ -233,6 +288,7 @@ impl Simulator {
         target: FoodKind,
     ) -> Result<Vec<TruePose>, KinovaError> {
         let start = Instant::now();
+        let cpu0 = thread_cpu_time();
         let mut props: [Option<FoodProps>; 3] = [None, None, None];
         for p in items {
             if props[p.props.kind.index()].is_some() {
@@ -278,6 +334,16 @@ impl Simulator {
             if let Some(p) = &props[kind.index()] {
                 self.apply_props(kind, p);
             }
+        }
+        // Items not on the plate, and the leaf when nothing lies on it, are
+        // parked: no contacts and weightless, so they cost the solver
+        // nothing (resting on the floor they made half of all contacts).
+        for kind in FoodKind::ALL {
+            let body = self.ids.food[kind.index()].body;
+            self.set_parked(body, props[kind.index()].is_none());
+        }
+        if let Some(l) = leaf_ids {
+            self.set_parked(l.body, leaf.is_none());
         }
         // Recompute the model constants that depend on masses and inertias
         // (constraint scaling uses them).
@@ -346,7 +412,34 @@ impl Simulator {
             self.physics_step(&mut idle)?;
         }
         self.timing.total += start.elapsed();
+        self.timing.cpu += thread_cpu_time().saturating_sub(cpu0);
         Ok(self.true_poses())
+    }
+
+    /// Parks `body` (no contacts, gravity compensated, allowed to sleep)
+    /// or restores it (never asleep: the skewering model pushes it with
+    /// applied forces, which must act at once).
+    fn set_parked(&mut self, body: usize, parked: bool) {
+        use mujoco_rs::mujoco_c::mjtSleepPolicy::{mjSLEEP_ALLOWED, mjSLEEP_NEVER};
+        // SAFETY: only contact bits and gravity compensation of existing
+        // elements change; no count, address or array size.
+        let m = unsafe { self.data.model_mut() };
+        let adr = m.body_geomadr()[body];
+        let num = m.body_geomnum()[body];
+        for g in adr.max(0) as usize..(adr.max(0) + num.max(0)) as usize {
+            let (t, a) = if parked { (0, 0) } else { self.contacts0[g] };
+            m.geom_contype_mut()[g] = t;
+            m.geom_conaffinity_mut()[g] = a;
+        }
+        m.body_gravcomp_mut()[body] = if parked { 1.0 } else { 0.0 };
+        let tree = m.body_treeid()[body];
+        if tree >= 0 {
+            m.tree_sleep_policy_mut()[tree as usize] = if parked {
+                mjSLEEP_ALLOWED
+            } else {
+                mjSLEEP_NEVER
+            };
+        }
     }
 
     fn apply_props(&mut self, kind: FoodKind, p: &FoodProps) {
@@ -455,6 +548,7 @@ impl Simulator {
         let t0 = Instant::now();
         self.data.step();
         self.timing.in_step += t0.elapsed();
+        self.timing.steps += 1;
         Ok(())
     }
 
@@ -466,6 +560,7 @@ impl Simulator {
         mut keyframe: Option<KeyframeHook<'_>>,
     ) -> Result<AttemptReport, KinovaError> {
         let start = Instant::now();
+        let cpu0 = thread_cpu_time();
         let Some(target) = self.target.take() else {
             return Err(KinovaError::MjcfInvalid {
                 origin: "scene".into(),
@@ -475,10 +570,16 @@ impl Simulator {
         let t_begin = self.data.time();
         let steps_before = self.step_count();
         let beta = action.pitch;
-        let fork = [beta, 0.0];
-        let psi = wrap_half_pi(perceived.yaw + action.roll);
-        let base = fork_base_orientation(psi);
-        let u = tine_direction(beta, psi);
+        // With the fork's γ the arm holds the handle with the tine row (at
+        // γ = 0) along the major axis and γ turns it by the action's roll;
+        // with the arm, the whole fork turns about the vertical.
+        let (gamma, handle_yaw) = match self.roll_by {
+            RollBy::ForkGamma => (action.roll, perceived.yaw),
+            RollBy::ArmYaw => (0.0, perceived.yaw + action.roll),
+        };
+        let fork = [beta, gamma];
+        let base = fork_base_orientation(wrap_half_pi(handle_yaw));
+        let u = tine_direction(&base, beta, gamma);
         let c = Vector3::from(perceived.centre);
         let entry = c + Vector3::new(0.0, 0.0, perceived.half_height);
         let pre = entry - PRE_OFFSET * u;
@@ -506,7 +607,9 @@ impl Simulator {
         }
         self.check_finite("pre-pose")?;
         let reached_pitch = self.data.qpos()[self.ids.fork_qpos[0]];
+        let reached_gamma = self.data.qpos()[self.ids.fork_qpos[1]];
         let reached_roll = self.row_angle_to(perceived.yaw);
+        let handle_roll = self.handle_angle_to(perceived.yaw);
         let tare = self.wrist_force();
         if let Some(k) = keyframe.as_mut() {
             k("pre_pose", &mut self.data);
@@ -550,48 +653,55 @@ impl Simulator {
             k("skewer", &mut self.data);
         }
 
-        // Lift straight up, then hold.
+        // Lift straight up on a minimum-jerk profile (a real arm's
+        // trajectory generator ramps up and down; an instant 10 cm/s start
+        // jerks the item off the tines), then hold.
         let tip0 = pre + travel * u;
-        let mut lift = 0.0;
-        step_i = 0;
-        while lift < LIFT {
-            lift += 0.10 * self.dt;
-            if step_i % 2 == 0 {
+        let n_lift = (LIFT_TIME / self.dt).round() as usize;
+        for i in 1..=n_lift {
+            if i % 2 == 0 || i == n_lift {
+                let lift = LIFT * min_jerk(i as f64 / n_lift as f64);
                 let target = PoseTarget {
                     tip: tip0 + Vector3::new(0.0, 0.0, lift),
                     base,
                 };
                 q = self.kin.dls_step(&q, fork, &target, 0.05).0;
             }
-            step_i += 1;
             self.set_ctrl(&q, fork);
             self.physics_step(&mut skewer)?;
         }
         if let Some(k) = keyframe.as_mut() {
             k("lift", &mut self.data);
         }
-        for _ in 0..(HOLD / self.dt) as usize {
+        let b = self.ids.food[target.index()].body;
+        let lifted_height = self.data.xpos()[b][2] - self.plate_top_centre().z;
+        let slip_at_lift = skewer.stats.slip_m;
+        for _ in 0..(self.hold / self.dt).round() as usize {
             self.physics_step(&mut skewer)?;
         }
         self.check_finite("hold")?;
         if let Some(k) = keyframe.as_mut() {
             k("hold", &mut self.data);
         }
-        let b = self.ids.food[target.index()].body;
         let height = self.data.xpos()[b][2] - self.plate_top_centre().z;
         let success = height > LIFTED && skewer.pierced_into(target.index()) >= 1;
         self.timing.total += start.elapsed();
+        self.timing.cpu += thread_cpu_time().saturating_sub(cpu0);
         self.timing.attempts += 1;
         Ok(AttemptReport {
             action: action.name,
             food: target,
             success,
             reached_pitch,
+            reached_gamma,
             reached_roll,
+            handle_roll,
             stop,
             peak_force: peak,
             tines: skewer.stats,
             final_height: height,
+            lifted_height,
+            hold_slip: skewer.stats.slip_m - slip_at_lift,
             sim_time: self.data.time() - t_begin,
             steps: self.step_count() - steps_before,
         })
@@ -601,14 +711,18 @@ impl Simulator {
         (self.data.time() / self.dt).round() as u64
     }
 
-    /// Angle in [0, π/2] between the tine row (fork y axis, horizontal part)
-    /// and the major axis at `yaw`.
+    /// Angle in [0, π/2] between the tine row (the roll link's y axis,
+    /// horizontal part) and the major axis at `yaw`.
     fn row_angle_to(&self, yaw: f64) -> f64 {
         let r = Matrix3::from_row_slice(&self.data.xmat()[self.ids.fork_body]);
-        let y = r.column(1);
-        let row_yaw = y[1].atan2(y[0]);
-        let d = wrap_half_pi(row_yaw - yaw);
-        d.abs()
+        horizontal_angle(&r.column(1).into_owned(), yaw)
+    }
+
+    /// Angle in [0, π/2] between the fork base's y axis (horizontal part)
+    /// and the major axis at `yaw`.
+    fn handle_angle_to(&self, yaw: f64) -> f64 {
+        let r = Matrix3::from_row_slice(&self.data.site_xmat()[self.ids.wrist_site]);
+        horizontal_angle(&r.column(1).into_owned(), yaw)
     }
 
     fn check_finite(&self, phase: &'static str) -> Result<(), KinovaError> {
@@ -622,6 +736,26 @@ impl Simulator {
                 phase,
             })
         }
+    }
+}
+
+/// Angle in [0, π/2] between the horizontal part of `axis` and the line at `yaw`.
+fn horizontal_angle(axis: &Vector3<f64>, yaw: f64) -> f64 {
+    wrap_half_pi(axis.y.atan2(axis.x) - yaw).abs()
+}
+
+/// CPU time consumed by the calling thread so far.
+pub fn thread_cpu_time() -> Duration {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes one timespec through a valid pointer.
+    let ok = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0;
+    if ok {
+        Duration::new(ts.tv_sec.max(0) as u64, ts.tv_nsec.max(0) as u32)
+    } else {
+        Duration::ZERO
     }
 }
 

@@ -68,6 +68,10 @@ pub enum TineState {
         prev: Vector3<f64>,
         /// Length of the sideways slot cut so far (m).
         cut: f64,
+        /// Direction of the channel the tine cut, in the item frame.
+        channel: Vector3<f64>,
+        /// Misalignment of channel and tine at the previous step, for damping.
+        prev_tilt: Vector3<f64>,
     },
     /// Torn out of the item; stays free for the rest of the attempt.
     Torn,
@@ -122,6 +126,9 @@ pub struct SkewerStats {
     pub torn: usize,
     /// Tines the item slid off.
     pub slid_off: usize,
+    /// Distance the target slid towards the tips, summed over its pierced
+    /// tines (m): how far it crept along the fork.
+    pub slip_m: f64,
 }
 
 /// The interaction state of the four tines.
@@ -260,6 +267,8 @@ impl SkewerModel {
                         s,
                         prev: Vector3::zeros(),
                         cut: 0.0,
+                        channel: f.rot.transpose() * u,
+                        prev_tilt: Vector3::zeros(),
                     };
                 }
                 // Lateral: the tip drags the surface point by friction.
@@ -284,6 +293,8 @@ impl SkewerModel {
                 mut s,
                 prev,
                 mut cut,
+                mut channel,
+                prev_tilt,
             } => {
                 let f = &foods[food];
                 let Some(props) = f.props else {
@@ -327,8 +338,12 @@ impl SkewerModel {
                     props.cut_resistance
                 };
                 let mut da_new = da;
+                let s_before = s;
                 if f_ax.abs() > cap {
                     da_new = -f_ax.signum() * cap / k;
+                    if food == self.target && da > da_new {
+                        self.stats.slip_m += da - da_new;
+                    }
                     s -= da - da_new;
                     f_ax = f_ax.signum() * cap;
                 }
@@ -336,19 +351,52 @@ impl SkewerModel {
                     self.stats.slid_off += 1;
                     return TineState::Free;
                 }
+                // An advancing tine cuts its channel along its own current
+                // direction: the newly cut share of the embedded length
+                // follows the tine, so a tine that turns while it pushes
+                // in (an item shoved across the plate) leaves no bent
+                // channel to spring back when the item comes free.
+                let advanced = s - s_before;
+                if advanced > 0.0 && embedded > 1e-4 {
+                    let w = (advanced / embedded).min(1.0);
+                    let local_u = f.rot.transpose() * u;
+                    channel = (channel * (1.0 - w) + local_u * w).normalize();
+                }
                 if s > TINE_LENGTH {
                     // The item reached the tine root: the fork body pushes it.
                     s = TINE_LENGTH;
                 }
                 let on_food = f_ax * u + f_lat;
+                // The flesh is held where the tine passes through it, so
+                // the force acts at the anchor: several tines together
+                // resist the item turning, as a real fork does. (Applied at
+                // the centre of mass instead, a skewered item keeps the
+                // spin it had at lift-off for ever, its anchors sweep
+                // sideways through the flesh and it creeps off.)
                 out_food[food].add_at(on_food, f.com, f.com);
                 fork.add_at(-on_food, pt, fork_com);
+                // An embedded tine is a line through the flesh, not a point:
+                // it resists the item turning off its axis like a spring
+                // spread along the embedded length L (stiffness k·L²/12),
+                // which stops a skewered item swinging about its tines.
+                let tilt = (f.rot * channel).cross(&u);
+                let l2 = embedded * embedded / 12.0;
+                let tilt_rate = if prev_tilt == Vector3::zeros() {
+                    Vector3::zeros()
+                } else {
+                    (tilt - prev_tilt) / self.dt
+                };
+                let bend = k * l2 * tilt + c * l2 * tilt_rate;
+                out_food[food].torque += bend;
+                fork.torque -= bend;
                 TineState::Pierced {
                     food,
                     anchor,
                     s,
                     prev: dl + da_new * u,
                     cut,
+                    channel,
+                    prev_tilt: tilt,
                 }
             }
         }

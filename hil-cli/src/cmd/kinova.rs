@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use hil_core::{HilError, Result};
 use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyResult};
 use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
+use hil_kinova_mujoco::controller::RollBy;
 use hil_kinova_mujoco::food::{Label, parse_labels};
 use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
 use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
@@ -58,6 +59,11 @@ pub struct CalibrateArgs {
     /// counts, heights) to this file as JSON lines.
     #[arg(long)]
     pub attempts: Option<PathBuf>,
+    /// What turns the tine row by an action's roll: `fork_gamma` (the
+    /// fork's γ joint about the pitched handle) or `arm_yaw` (the arm turns
+    /// a rigid fork about the vertical, as in the published data set).
+    #[arg(long, default_value = "fork_gamma")]
+    pub roll_by: String,
     /// Print a JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -92,6 +98,14 @@ pub struct KinovaDemoArgs {
     /// Master seed [default: the file's, else 7].
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Run the whole study (pretraining, validation, plates) on this many
+    /// consecutive master seeds and report every figure as the mean ± the
+    /// standard error over the seeds.
+    #[arg(long, default_value_t = 1)]
+    pub seeds: usize,
+    /// Worker threads for --seeds (default: one per core).
+    #[arg(long)]
+    pub threads: Option<usize>,
     /// Write PNG keyframes of every attempt into this directory (offscreen
     /// EGL; needs the `kinova_feeding` environment).
     #[arg(long)]
@@ -156,7 +170,15 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             "must be at least 1",
         ));
     }
+    let roll_by = RollBy::parse(&args.roll_by).ok_or_else(|| {
+        HilError::invalid_parameter(
+            "--roll-by",
+            args.roll_by.clone(),
+            "expected fork_gamma or arm_yaw",
+        )
+    })?;
     let opts = CalibrationOptions {
+        roll_by,
         foods: labels_or_all("--foods", &args.foods)?,
         settings: labels_or_all("--settings", &args.settings)?,
         trials: args.trials,
@@ -212,7 +234,7 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     let header = || {
         print!("{:<22}", "food");
         for a in hil_envs::feeding::action_space().names() {
-            print!("{a:>13}");
+            print!("{a:>18}");
         }
         println!();
     };
@@ -220,39 +242,51 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     for chunk in report.rows.chunks(6) {
         print!("{:<22}", chunk[0].food);
         for r in chunk {
-            print!("{:>13}", cell(r.rate, r.published));
+            print!("{:>18}", cell(r.rate, r.se, r.published));
         }
         println!();
         for (i, c) in chunk[0].by_setting.iter().enumerate() {
             print!("{:<22}", format!("  {}", c.setting.name()));
             for r in chunk {
                 let c = &r.by_setting[i];
-                print!("{:>13}", cell(c.rate, c.published));
+                print!("{:>18}", cell(c.rate, c.se, c.published));
             }
             println!();
         }
     }
     println!(
-        "mean |simulated - published| = {:.3} overall, {:.3} per setting; {:.1} attempts/s on {} threads ({:.1} per core); {:.1}% of time outside mj_step",
+        "mean |simulated - published| = {:.3} overall (largest {:.3}), {:.3} per setting; hold {:.1} s; {:.1} attempts/s on {} threads ({:.1} per core); {:.0} steps per attempt at {:.1} µs per mj_step; {:.1}% of time outside mj_step",
         report.mean_abs_error,
+        report.max_abs_error,
         report.mean_abs_error_by_setting,
+        report.hold_s,
         report.attempts_per_second,
         report.threads,
         report.attempts_per_second_per_core,
+        report.steps_per_attempt,
+        report.micros_per_step,
         100.0 * report.overhead_share
     );
     Ok(())
 }
 
-fn cell(rate: f64, published: Option<f64>) -> String {
+fn cell(rate: f64, se: f64, published: Option<f64>) -> String {
     let p = published.map_or("  -  ".into(), |p| format!("{p:.2}"));
-    format!("{rate:.2} ({p})")
+    format!("{rate:.2}±{se:.2} ({p})")
 }
 
 /// What the results are, printed with them.
 const NOTE: &str = "simulation of the user-study protocol; food properties are synthetic, \
-                    calibrated to published success rates, and the workload model is fitted \
-                    to synthetic study data: these are not the paper's results";
+                    calibrated to published success rates, and the workload model is a \
+                    bundled synthetic one: these are not the paper's results";
+
+/// The paper's real-robot user study, per method: r_task_avg, n_success
+/// and n_q per plate (means; Table in the paper's user-study section).
+const PAPER_STUDY: [(&str, f64, f64, f64); 3] = [
+    ("LinUCB", 0.38, 2.00, 0.0),
+    ("AlwaysQuery", 0.87, 2.68, 3.0),
+    ("LinUCB-QG", 0.68, 2.53, 1.74),
+];
 
 /// The study `hil demo kinova` runs: the paper's protocol, changed by
 /// `--components` and then by the flags.
@@ -301,6 +335,20 @@ fn kinova_scene(cfg: &UserStudyConfig, base: &Path) -> Result<Option<KinovaFeedi
 }
 
 fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
+    if args.seeds == 0 || args.threads == Some(0) {
+        return Err(HilError::invalid_parameter(
+            if args.seeds == 0 {
+                "--seeds"
+            } else {
+                "--threads"
+            },
+            0,
+            "must be at least 1",
+        ));
+    }
+    if args.seeds > 1 {
+        return demo_many_seeds(&args);
+    }
     let cfg = demo_config(&args)?;
     let base = args
         .components
@@ -345,7 +393,8 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
                 &mut env,
                 |plate, env, episode| {
                     progress(plate);
-                    let Some(w) = writer.as_mut() else {
+                    // Validation plates (repetition 0) are not pictured.
+                    let Some(w) = writer.as_mut().filter(|_| plate.repetition > 0) else {
                         return episode(env, &mut []);
                     };
                     recorder.set_prefix(format!("rep{}_{}", plate.repetition, slug(&plate.label)));
@@ -412,6 +461,7 @@ fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
             "protocol": result.protocol,
             "plates": result.plates,
             "methods": result.methods,
+            "selections": result.selections,
             "note": NOTE,
         });
         println!(
@@ -440,6 +490,24 @@ fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
             p.method, p.repetition, p.position, p.r_task_avg, p.n_success, p.n_q
         );
     }
+    for sel in &result.selections {
+        let tried: Vec<String> = sel
+            .grid
+            .iter()
+            .zip(&sel.m_wt)
+            .zip(&sel.n_q)
+            .map(|((v, m), q)| format!("{v}: {:.3} (n_q {q:.2})", m.mean))
+            .collect();
+        println!(
+            "{} {} = {} chosen by mean M_wt({}) over {} validation plates per value: {}",
+            sel.method,
+            sel.parameter,
+            sel.chosen,
+            sel.w_task,
+            sel.plates,
+            tried.join(", ")
+        );
+    }
     println!("\nper method (mean ± standard error over its plates):");
     for s in &result.methods {
         println!(
@@ -449,6 +517,148 @@ fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
             pm(s.n_success_per_plate, s.n_success_per_plate_sem, 2),
             pm(s.n_q_per_plate, s.n_q_per_plate_sem, 2),
             s.plates
+        );
+    }
+    Ok(())
+}
+
+/// `hil demo kinova --seeds N`: the whole study on N consecutive master
+/// seeds (in parallel), every figure as mean ± standard error over seeds.
+fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
+    use hil_experiments::user_study::mean_sem;
+    if args.render.is_some() {
+        return Err(HilError::invalid_parameter(
+            "--render",
+            "given",
+            "pictures are written for a single seed; drop --seeds or --render",
+        ));
+    }
+    let base_cfg = demo_config(args)?;
+    let base = args
+        .components
+        .as_deref()
+        .and_then(Path::parent)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("."));
+    let threads = args
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .min(args.seeds);
+    let first = base_cfg.seed;
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    if i >= args.seeds {
+                        break;
+                    }
+                    let run = demo_config(args).and_then(|mut cfg| {
+                        cfg.seed = first.wrapping_add(i as u64);
+                        cfg.run(&base, |_| {})
+                    });
+                    if !args.quiet {
+                        eprintln!("seed {} done", first.wrapping_add(i as u64));
+                    }
+                    results
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .push((i, run));
+                }
+            });
+        }
+    });
+    let mut runs = results.into_inner().unwrap_or_else(|e| e.into_inner());
+    runs.sort_by_key(|(i, _)| *i);
+    let runs: Vec<UserStudyResult> = runs.into_iter().map(|(_, r)| r).collect::<Result<_>>()?;
+    let per = |label: &str, f: fn(&hil_experiments::user_study::MethodSummary) -> f64| {
+        let xs: Vec<f64> = runs
+            .iter()
+            .filter_map(|r| r.methods.iter().find(|m| m.method == label).map(f))
+            .collect();
+        mean_sem(&xs)
+    };
+    let labels: Vec<String> = runs[0].methods.iter().map(|m| m.method.clone()).collect();
+    let mut rows = Vec::new();
+    for label in &labels {
+        rows.push(serde_json::json!({
+            "method": label,
+            "r_task_avg": per(label, |m| m.r_task_avg),
+            "n_success_per_plate": per(label, |m| m.n_success_per_plate),
+            "n_q_per_plate": per(label, |m| m.n_q_per_plate),
+            "paper": PAPER_STUDY.iter().find(|p| p.0 == label).map(|p| [p.1, p.2, p.3]),
+        }));
+    }
+    let mut chosen = Vec::new();
+    for sel in runs.iter().flat_map(|r| &r.selections) {
+        chosen.push((sel.method.clone(), sel.parameter.clone(), sel.chosen));
+    }
+    if args.json {
+        let out = serde_json::json!({
+            "seeds": (first..first + args.seeds as u64).collect::<Vec<_>>(),
+            "methods": rows,
+            "selections": runs.iter().map(|r| &r.selections).collect::<Vec<_>>(),
+            "protocol": runs[0].protocol,
+            "note": NOTE,
+        });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
+        );
+        return Ok(());
+    }
+    let p = &runs[0].protocol;
+    println!(
+        "User-study protocol in simulation over {} seeds ({}..={}): {}: {}; N_att = {}; {} repetitions per seed.",
+        args.seeds,
+        first,
+        first + args.seeds as u64 - 1,
+        p.environment,
+        p.foods.join(", "),
+        p.n_att,
+        p.repetitions
+    );
+    println!("Note: {NOTE}.");
+    println!(
+        "per method: mean ± standard error over seeds (each seed's mean over its plates); paper's real study in brackets"
+    );
+    for label in &labels {
+        let r = per(label, |m| m.r_task_avg);
+        let s = per(label, |m| m.n_success_per_plate);
+        let q = per(label, |m| m.n_q_per_plate);
+        let paper = PAPER_STUDY
+            .iter()
+            .find(|p| p.0 == label)
+            .map_or(String::new(), |p| {
+                format!(" [{:.2} / {:.2} / {:.2}]", p.1, p.2, p.3)
+            });
+        println!(
+            "{:<12} r_task_avg {}  n_success {}  n_q {}{paper}",
+            label,
+            pm(r.mean, r.sem, 3),
+            pm(s.mean, s.sem, 2),
+            pm(q.mean, q.sem, 2)
+        );
+    }
+    let mut methods: Vec<&String> = chosen.iter().map(|c| &c.0).collect();
+    methods.dedup();
+    for m in methods {
+        let vals: Vec<f64> = chosen.iter().filter(|c| &c.0 == m).map(|c| c.2).collect();
+        let param = &chosen
+            .iter()
+            .find(|c| &c.0 == m)
+            .map(|c| c.1.clone())
+            .unwrap_or_default();
+        let ms = mean_sem(&vals);
+        println!(
+            "{m} {param} chosen on validation (highest mean M_wt) per seed: {} (mean {})",
+            vals.iter()
+                .map(|v| v.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            pm(ms.mean, ms.sem, 2)
         );
     }
     Ok(())

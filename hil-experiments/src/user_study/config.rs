@@ -74,20 +74,59 @@ pub struct UserStudyConfig {
         deserialize_with = "hil_core::plugin::component"
     )]
     pub channel: Box<dyn QueryChannelConfig>,
-    /// The methods compared, in the order of the first repetition.
+    /// The methods compared, in the order of the first repetition. A
+    /// method may tune one hyperparameter (`tune = { w = [...] }`): the
+    /// value with the highest mean M_wt over the [`Validation`] plates is
+    /// used in the study.
     #[serde(default = "paper_methods")]
     pub methods: Vec<Method>,
+    /// The simulated validation run that chooses tuned hyperparameters.
+    #[serde(default)]
+    pub validation: Validation,
+}
+
+/// The simulated validation run of a study: before the study, every
+/// tuned method runs `plates` plates (on seeds apart from the study's) at
+/// every value of its grid, with a fresh policy per value, and the value
+/// with the highest mean M_wt(`w_task`) = w_task·r_task_avg − (1 −
+/// w_task)·ΔWL is kept — the criterion the simulated testbed selects by.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Validation {
+    /// Validation plates per grid value (≥ 1).
+    pub plates: usize,
+    /// The task weight of the selection criterion, in [0, 1].
+    pub w_task: f64,
+}
+
+/// The testbed's figure w_task (0.7), used for the study's selection too.
+pub const PAPER_VALIDATION_W_TASK: f64 = 0.7;
+
+impl Default for Validation {
+    fn default() -> Self {
+        Self {
+            plates: 4,
+            w_task: PAPER_VALIDATION_W_TASK,
+        }
+    }
 }
 
 /// The study's attempts per item (N_att), as in the paper's user study.
 pub const PAPER_N_ATT: u32 = 3;
 /// Initial workload WL_0 of every plate.
 const PAPER_WL0: f64 = 0.5;
-/// LinUCB-QG's workload weight w.
-const PAPER_W: f64 = 0.3;
+/// LinUCB-QG's grid of workload weights w, chosen on validation (the
+/// simulated testbed's grid).
+pub const PAPER_W_GRID: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
 /// Simulated pretraining attempts per (food, action) in the MuJoCo scene:
-/// few, because each is a physics simulation.
-const PAPER_PRETRAINING_TRIALS: usize = 2;
+/// 10 per (food, action), 180 in all, so that the pretrained estimator's
+/// confidence bonuses are no longer dominated by the prior.
+const PAPER_PRETRAINING_TRIALS: usize = 10;
+/// The workload model of the study: the paper's simulation model over the
+/// 12 query variables, whose weights are positive, so its forecast never
+/// falls when a query is asked (the fitted `f12_real` forecasts a lower
+/// workload after some queries, which makes LinUCB-QG's gate meaningless).
+pub const PAPER_WORKLOAD: &str = "f12_sim";
 
 fn paper_seed() -> u64 {
     7
@@ -102,14 +141,17 @@ fn paper_session() -> SessionSettings {
         .with_max_items(None)
 }
 fn paper_environment() -> Box<dyn EnvironmentConfig> {
+    // As in the study: one item at a time, alone on the plate.
     Box::new(hil_kinova_mujoco::KinovaFeedingConfig {
         pretraining_trials: PAPER_PRETRAINING_TRIALS,
+        settings: vec!["isolated".into()],
+        neighbours: false,
         ..Default::default()
     })
 }
 fn paper_workload() -> Box<dyn WorkloadModelConfig> {
     Box::new(hil_workload::config::BundledModelConfig {
-        name: "f12_real".into(),
+        name: PAPER_WORKLOAD.into(),
     })
 }
 fn paper_channel() -> Box<dyn QueryChannelConfig> {
@@ -120,7 +162,8 @@ fn paper_methods() -> Vec<Method> {
     vec![
         Method::new("LinUCB", paper_policy("linucb", &[])),
         Method::new("AlwaysQuery", paper_policy("always_query", &[])),
-        Method::new("LinUCB-QG", paper_policy("linucb_qg", &[("w", PAPER_W)])),
+        Method::new("LinUCB-QG", paper_policy("linucb_qg", &[("w", 1.0)]))
+            .tuned("w", &PAPER_W_GRID),
     ]
 }
 
@@ -143,10 +186,12 @@ impl Default for UserStudyConfig {
 
 impl UserStudyConfig {
     /// The paper's real-robot protocol, in the MuJoCo scene: a plate of
-    /// banana, baby carrot and cantaloupe (`kinova_feeding`, 2 simulated
-    /// pretraining attempts per food and action); N_att = 3, WL_0 = 0.5;
-    /// LinUCB, AlwaysQuery and LinUCB-QG (α = 0.5, w = 0.3, pretrained);
-    /// the bundled `f12_real` workload model; a perfect `simulated_expert`
+    /// banana, baby carrot and cantaloupe, each item alone on the plate
+    /// (`kinova_feeding`, `isolated`, 10 simulated pretraining attempts per
+    /// food and action); N_att = 3, WL_0 = 0.5; LinUCB, AlwaysQuery and
+    /// LinUCB-QG (α = 0.5, pretrained, w chosen from [`PAPER_W_GRID`] by
+    /// mean M_wt(0.7) over 4 validation plates per value); the bundled `f12_sim`
+    /// workload model (a query never lowers its forecast); a perfect `simulated_expert`
     /// answering; 2 repetitions; seed 7. `examples/configs/user-study.toml`
     /// is this config written out.
     ///
@@ -164,6 +209,7 @@ impl UserStudyConfig {
             workload: paper_workload(),
             channel: paper_channel(),
             methods: paper_methods(),
+            validation: Validation::default(),
         }
     }
 
@@ -206,6 +252,12 @@ impl UserStudyConfig {
         if self.repetitions == 0 {
             return Err(at(&["repetitions"], "must be at least 1"));
         }
+        if self.validation.plates == 0 {
+            return Err(at(&["validation", "plates"], "must be at least 1"));
+        }
+        if !(0.0..=1.0).contains(&self.validation.w_task) {
+            return Err(at(&["validation", "w_task"], "must be in [0, 1]"));
+        }
         if self.methods.is_empty() {
             return Err(at(&["methods"], "name at least one method"));
         }
@@ -218,11 +270,10 @@ impl UserStudyConfig {
                 let msg = format!("`{}` names two methods; labels must be unique", m.label);
                 return Err(located_label(text, path, i, &msg));
             }
-            if !m.tune.is_empty() {
+            if m.tune.len() > 1 || m.tune.values().any(|g| g.is_empty()) {
                 return Err(at(
                     &["methods", "tune"],
-                    "a user study does not tune hyperparameters (it has no validation phase); \
-                     give the policy's values in `policy`",
+                    "tune at most one hyperparameter, over at least one value",
                 ));
             }
         }

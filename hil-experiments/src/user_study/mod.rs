@@ -16,10 +16,12 @@
 //! wl0 = 0.5
 //! [environment]             # built once, shared by every plate
 //! type = "kinova_feeding"
-//! pretraining_trials = 2
+//! pretraining_trials = 10
+//! settings = ["isolated"]
+//! neighbours = false
 //! [workload]
 //! type = "bundled"
-//! name = "f12_real"
+//! name = "f12_sim"
 //! [channel]                 # who answers; a fresh one for every plate
 //! type = "simulated_expert"
 //! [[methods]]
@@ -30,7 +32,11 @@
 //! policy = { type = "always_query", alpha = 0.5, lambda = 1.0, pretrain = true }
 //! [[methods]]
 //! label = "LinUCB-QG"
-//! policy = { type = "linucb_qg", alpha = 0.5, lambda = 1.0, w = 0.3, pretrain = true }
+//! policy = { type = "linucb_qg", alpha = 0.5, lambda = 1.0, w = 1.0, pretrain = true }
+//! tune = { w = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0] }
+//! [validation]              # chooses tuned values: highest mean M_wt(w_task)
+//! plates = 4
+//! w_task = 0.7
 //! ```
 //!
 //! Run it with [`UserStudyConfig::run`], or, to observe or wrap the
@@ -40,8 +46,10 @@
 mod config;
 mod run;
 
-pub use config::{PAPER_N_ATT, UserStudyConfig};
+pub use config::{
+    PAPER_N_ATT, PAPER_VALIDATION_W_TASK, PAPER_W_GRID, PAPER_WORKLOAD, UserStudyConfig, Validation,
+};
 pub use run::{
-    Episode, MeanSem, MethodSummary, Plate, PlateResult, Protocol, UserStudy, UserStudyResult,
-    mean_sem, method_order,
+    Episode, MeanSem, MethodSummary, Plate, PlateResult, Protocol, Selection, UserStudy,
+    UserStudyResult, mean_sem, method_order,
 };

@@ -70,7 +70,33 @@ pub struct PlateResult {
     pub n_q: usize,
     /// Steps (attempts) taken.
     pub n_steps: usize,
+    /// Change of workload over the plate, ΔWL.
+    pub delta_wl: f64,
 }
+
+/// How a tuned method's hyperparameter was chosen on validation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Selection {
+    /// The method's label.
+    pub method: String,
+    /// The tuned hyperparameter.
+    pub parameter: String,
+    /// The grid of values tried.
+    pub grid: Vec<f64>,
+    /// Mean M_wt(`w_task`) over the validation plates, per grid value.
+    pub m_wt: Vec<MeanSem>,
+    /// Mean queries per validation plate, per grid value.
+    pub n_q: Vec<f64>,
+    /// The task weight of the criterion.
+    pub w_task: f64,
+    /// Validation plates per value.
+    pub plates: usize,
+    /// The value used in the study (highest mean M_wt; ties: the first).
+    pub chosen: f64,
+}
+
+/// Seed stream of validation plates (apart from the study's plates).
+const VALIDATION_STREAM: u64 = 0x7661_6c69_6461_7465;
 
 /// A mean over plates with its standard error.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -166,6 +192,8 @@ pub struct UserStudyResult {
     pub plates: Vec<PlateResult>,
     /// Per method, in the config's order.
     pub methods: Vec<MethodSummary>,
+    /// How each tuned method's hyperparameter was chosen.
+    pub selections: Vec<Selection>,
 }
 
 /// Runs one plate's episode on the environment it is given, with extra
@@ -295,6 +323,7 @@ impl UserStudy<'_> {
         mut on_plate: impl FnMut(&PlateResult),
     ) -> Result<UserStudyResult> {
         let cfg = self.config;
+        let selections = self.select_tuned(env, &mut each)?;
         let mut plates = Vec::new();
         let mut foods: Vec<String> = Vec::new();
         let mut env_name = String::new();
@@ -329,6 +358,7 @@ impl UserStudy<'_> {
                 n_success: m.n_success,
                 n_q: m.n_q,
                 n_steps: m.n_steps,
+                delta_wl: m.delta_wl,
             };
             on_plate(&result);
             plates.push(result);
@@ -353,7 +383,81 @@ impl UserStudy<'_> {
             },
             plates,
             methods,
+            selections,
         })
+    }
+
+    /// The validation phase: for every tuned method, runs
+    /// `validation.plates` plates at every grid value with a fresh policy,
+    /// keeps the value with the highest mean M_wt and rebuilds the
+    /// method's policy at it. Validation plates reach `each` with
+    /// repetition 0.
+    fn select_tuned<E: ?Sized>(
+        &mut self,
+        env: &mut E,
+        each: &mut impl FnMut(&Plate, &mut E, &mut Episode<'_>) -> Result<EpisodeReport>,
+    ) -> Result<Vec<Selection>> {
+        let cfg = self.config;
+        let v = &cfg.validation;
+        let mut selections = Vec::new();
+        for (k, method) in cfg.methods.iter().enumerate() {
+            let Some((parameter, grid)) = method.tune.iter().next() else {
+                continue;
+            };
+            let mut m_wt = Vec::new();
+            let mut n_q = Vec::new();
+            for point in method.grid() {
+                let mut policy = method.config(&point)?.build(&self.ctx)?;
+                let value = point.as_ref().map_or(f64::NAN, |p| p.1);
+                let mut scores = Vec::new();
+                let mut queries = 0usize;
+                for i in 0..v.plates {
+                    let plate = Plate {
+                        method: k,
+                        label: format!("{} (validation, {parameter} = {value})", method.label),
+                        repetition: 0,
+                        position: i + 1,
+                        seed: splitmix(cfg.seed ^ VALIDATION_STREAM, i as u64),
+                    };
+                    let mut channel = cfg.channel.build(&self.ctx)?;
+                    let workload = Arc::clone(&self.workload);
+                    let policy = policy.as_mut();
+                    let mut episode =
+                        |env: &mut dyn Environment, observers: &mut [&mut dyn SessionObserver]| {
+                            Session::new(
+                                cfg.session.clone(),
+                                env,
+                                &mut *policy,
+                                channel.as_mut(),
+                                Arc::clone(&workload),
+                            )
+                            .run_episode(plate.seed, observers)
+                        };
+                    let report = each(&plate, env, &mut episode)?;
+                    scores.push(report.metrics.m_wt(v.w_task));
+                    queries += report.metrics.n_q;
+                }
+                m_wt.push(mean_sem(&scores));
+                n_q.push(queries as f64 / v.plates as f64);
+            }
+            let best =
+                (0..grid.len()).fold(0, |b, i| if m_wt[i].mean > m_wt[b].mean { i } else { b });
+            let chosen = grid[best];
+            self.policies[k] = method
+                .config(&Some((parameter.clone(), chosen)))?
+                .build(&self.ctx)?;
+            selections.push(Selection {
+                method: method.label.clone(),
+                parameter: parameter.clone(),
+                grid: grid.clone(),
+                m_wt,
+                n_q,
+                w_task: v.w_task,
+                plates: v.plates,
+                chosen,
+            });
+        }
+        Ok(selections)
     }
 }
 

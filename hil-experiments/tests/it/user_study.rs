@@ -88,8 +88,8 @@ alpha = "high"
 }
 
 #[test]
-fn a_tuned_method_is_refused_by_name() {
-    let text = "[[methods]]\nlabel = \"QG\"\npolicy = { type = \"linucb_qg\", alpha = 0.5, w = 1.0 }\ntune = { w = [1.0, 2.0] }\n";
+fn two_tuned_hyperparameters_are_refused_by_name() {
+    let text = "[[methods]]\nlabel = \"QG\"\npolicy = { type = \"linucb_qg\", alpha = 0.5, w = 1.0 }\ntune = { w = [1.0, 2.0], alpha = [0.5] }\n";
     let err = parse(text).unwrap_err();
     assert_eq!(err.field.as_deref(), Some("methods.tune"), "{err}");
     assert_eq!(err.line, 4, "{err}");
@@ -199,13 +199,20 @@ fn run_with_lets_the_caller_observe_every_plate() {
         .run_with(
             env.as_mut(),
             |plate, env, episode| {
+                // Validation plates (repetition 0) come first: 4 per w.
+                if plate.repetition == 0 {
+                    plates.push("validation".to_string());
+                    return episode(env, &mut []);
+                }
                 plates.push(plate.label.clone());
                 episode(env, &mut [&mut steps])
             },
             |_| {},
         )
         .unwrap();
-    assert_eq!(plates, ["LinUCB", "AlwaysQuery", "LinUCB-QG"]);
+    let validation = 4 * hil_experiments::user_study::PAPER_W_GRID.len();
+    assert!(plates[..validation].iter().all(|p| p == "validation"));
+    assert_eq!(plates[validation..], ["LinUCB", "AlwaysQuery", "LinUCB-QG"]);
     assert_eq!(
         steps.0,
         result.plates.iter().map(|p| p.n_steps).sum::<usize>()

@@ -1,0 +1,74 @@
+//! `hil demo kinova --seeds N`: the whole study on several master seeds,
+//! every figure as mean ± standard error over seeds beside the paper's, and
+//! the w each seed's validation chose (on the cheap dataset environment).
+
+mod common;
+use common::hil;
+
+#[test]
+fn many_seeds_report_means_with_standard_errors_and_the_chosen_w() {
+    let dir = std::env::temp_dir().join(format!("hil-kinova-seeds-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let study = dir.join("study.toml");
+    std::fs::write(
+        &study,
+        r#"
+repetitions = 2
+[environment]
+type = "food_replay"
+foods = ["banana", "carrot", "cantaloupe"]
+pretrain_foods = ["apple", "kiwi", "strawberry"]
+items_per_episode = 3
+[validation]
+plates = 2
+[[methods]]
+label = "LinUCB"
+policy = { type = "linucb", alpha = 0.5, pretrain = true }
+[[methods]]
+label = "AlwaysQuery"
+policy = { type = "always_query", alpha = 0.5, pretrain = true }
+[[methods]]
+label = "LinUCB-QG"
+policy = { type = "linucb_qg", alpha = 0.5, w = 1.0, pretrain = true }
+tune = { w = [0.5, 8.0] }
+"#,
+    )
+    .unwrap();
+    let out = hil(&[
+        "demo",
+        "kinova",
+        "--seeds",
+        "3",
+        "--threads",
+        "2",
+        "--json",
+        "--quiet",
+        "--components",
+        study.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["seeds"], serde_json::json!([7, 8, 9]));
+    let methods = v["methods"].as_array().unwrap();
+    assert_eq!(methods.len(), 3);
+    for m in methods {
+        for key in ["r_task_avg", "n_success_per_plate", "n_q_per_plate"] {
+            assert!(m[key]["mean"].is_number(), "{m}");
+            assert!(m[key]["sem"].is_number(), "three seeds give an SE: {m}");
+        }
+    }
+    assert_eq!(methods[1]["n_q_per_plate"]["mean"], 3.0);
+    assert_eq!(methods[2]["paper"], serde_json::json!([0.68, 2.53, 1.74]));
+    let selections = v["selections"].as_array().unwrap();
+    assert_eq!(selections.len(), 3);
+    for s in selections {
+        let chosen = s[0]["chosen"].as_f64().unwrap();
+        assert!(chosen == 0.5 || chosen == 8.0, "{s}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+
+    let out = hil(&["demo", "kinova", "--seeds", "0"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--seeds"));
+}

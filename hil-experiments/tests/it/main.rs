@@ -4,3 +4,4 @@
 mod testbed;
 mod user_study;
 mod user_study_plugins;
+mod user_study_selection;

@@ -2,7 +2,7 @@
 //! origins, malformed, oversized and concurrent requests, timeouts, and the
 //! conformance suite with a scripted person answering over HTTP.
 
-mod web_support;
+use crate::web_support;
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};

@@ -1,7 +1,7 @@
 //! `hil bench policy`: built-in and plugin policy types through
 //! `PolicyConfig`. Timings are never asserted, only what is reported.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -28,6 +28,7 @@ fn small_env() -> KinovaFeedingEnv {
 }
 
 #[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn forward_kinematics_matches_the_fact_sheet() {
     let mut sim = Simulator::new().unwrap();
     let base = {
@@ -70,6 +71,7 @@ fn forward_kinematics_matches_the_fact_sheet() {
 }
 
 #[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn every_action_reaches_its_commanded_pitch_and_roll() {
     let mut sim = Simulator::new().unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
@@ -105,6 +107,7 @@ fn every_action_reaches_its_commanded_pitch_and_roll() {
 }
 
 #[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn the_same_seed_replays_the_same_attempts() {
     let run = || {
         let mut env = small_env();
@@ -121,6 +124,7 @@ fn the_same_seed_replays_the_same_attempts() {
 }
 
 #[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn passes_the_environment_conformance_suite() {
     let report =
         check_environment(&|| Ok(Box::new(small_env()) as Box<dyn Environment>), 1).unwrap();
@@ -128,6 +132,7 @@ fn passes_the_environment_conformance_suite() {
 }
 
 #[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn a_short_episode_runs_through_the_session_loop() {
     let mut env = small_env();
     let query = Choice::Query {
@@ -224,6 +229,7 @@ fn staged(setting: &str, seed: u64) -> KinovaFeedingEnv {
 }
 
 #[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn each_setting_places_the_item_where_it_says() {
     use hil_kinova_mujoco::Setting;
     let plate = Simulator::new().unwrap().plate_top_centre();
@@ -275,6 +281,7 @@ fn an_unknown_setting_is_a_clear_error() {
 }
 
 #[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn calibration_does_not_depend_on_the_number_of_threads() {
     use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
     let run = |threads| {

@@ -19,7 +19,7 @@ use hil_core::{
 };
 use serde_json::json;
 
-mod browser_support;
+use crate::browser_support;
 use browser_support::{Browser, contrast, tools_present};
 
 fn query(t: u64, response: ResponseType) -> Query {

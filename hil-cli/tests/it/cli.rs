@@ -1,6 +1,6 @@
 //! The `hil` binary as a user meets it.
 
-mod common;
+use crate::common;
 use common::hil;
 
 #[test]

@@ -5,7 +5,7 @@
 //! export has exactly one row per survey. Then the README's loop: export,
 //! `hil workload summary`, `hil workload fit`, a `hil run` with the model.
 
-mod common;
+use crate::common;
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;

@@ -3,7 +3,7 @@
 //! person who holds the token, and the person's answer arrives while 64 of
 //! them trickle bytes.
 
-mod web_support;
+use crate::web_support;
 
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpStream};

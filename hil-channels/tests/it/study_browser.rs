@@ -7,7 +7,7 @@
 //! passes the accessibility checks; the export passes the study loader,
 //! has the expected pairs and fits a model.
 
-mod browser_support;
+use crate::browser_support;
 
 use std::time::{Duration, Instant};
 

@@ -3,7 +3,7 @@
 //! line, the task clock stopping while the participant is away, and
 //! located config errors.
 
-mod web_support;
+use crate::web_support;
 
 use std::net::SocketAddr;
 use std::path::PathBuf;

@@ -1,7 +1,7 @@
 //! `hil data` and `hil reproduce` end to end on a small generated dataset
 //! (d = 224, 2 images per setting) so that the debug build stays fast.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -6,7 +6,7 @@
 //! workload summary` reports a dataset it cannot build instead of dropping
 //! it.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Output;

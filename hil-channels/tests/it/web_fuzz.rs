@@ -7,7 +7,7 @@
 //! live server answers each input with a status from a bounded set and
 //! keeps serving.
 
-mod web_support;
+use crate::web_support;
 
 use proptest::prelude::*;
 

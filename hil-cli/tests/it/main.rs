@@ -1,0 +1,16 @@
+//! The integration tests of `hil-cli`, linked into one test binary (one
+//! link instead of one per file); each module was a file of its own.
+
+mod common;
+
+mod bench;
+mod cli;
+mod data_inputs;
+mod kinova;
+mod kinova_seeds;
+mod reproduce;
+mod resume;
+mod run_reliability;
+mod study_resume;
+mod terminal_pty;
+mod web_run;

@@ -1,0 +1,5 @@
+//! The integration tests of `hil-kinova-mujoco`, linked into one test binary (one
+//! link instead of one per file); each module was a file of its own.
+
+mod kinova;
+mod kinova_hold_roll;

@@ -307,19 +307,7 @@ impl DesignConfig {
 impl ServerConfig {
     /// Checks the host names and the away time.
     pub fn validate(&self) -> Result<()> {
-        for h in &self.allowed_hosts {
-            if h.is_empty()
-                || !h
-                    .bytes()
-                    .all(|b| b.is_ascii_alphanumeric() || b == b'.' || b == b'-')
-            {
-                return Err(HilError::invalid_parameter(
-                    "allowed_hosts",
-                    h,
-                    "must be a host name (letters, digits, dots, dashes)",
-                ));
-            }
-        }
+        crate::web::check_allowed_hosts(&self.allowed_hosts)?;
         check_seconds("away_after_s", self.away_after_s)
     }
 }

@@ -176,23 +176,30 @@ impl std::fmt::Debug for WebChannel {
     }
 }
 
+/// Every extra name a page may be reached by (`allowed_hosts`, of the query
+/// page and of the study) must be a plain host name.
+pub(crate) fn check_allowed_hosts(hosts: &[String]) -> Result<()> {
+    for h in hosts {
+        if h.is_empty()
+            || !h
+                .bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b == b'.' || b == b'-')
+        {
+            return Err(HilError::invalid_parameter(
+                "allowed_hosts",
+                h,
+                "must be a host name (letters, digits, dots, dashes)",
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl WebChannel {
     /// Validates `config`, binds the server and starts serving.
     pub fn start(config: WebChannelConfig) -> Result<Self> {
         config.validate()?;
-        for h in &config.allowed_hosts {
-            if h.is_empty()
-                || !h
-                    .bytes()
-                    .all(|b| b.is_ascii_alphanumeric() || b == b'.' || b == b'-')
-            {
-                return Err(HilError::invalid_parameter(
-                    "allowed_hosts",
-                    h,
-                    "must be a host name (letters, digits, dots, dashes)",
-                ));
-            }
-        }
+        check_allowed_hosts(&config.allowed_hosts)?;
         if let Some(dir) = &config.images
             && !dir.is_dir()
         {

@@ -202,6 +202,35 @@ pub struct UserStudyResult {
 pub type Episode<'a> =
     dyn FnMut(&mut dyn Environment, &mut [&mut dyn SessionObserver]) -> Result<EpisodeReport> + 'a;
 
+/// Runs one plate (of the study or of a validation run) with `policy` and a
+/// fresh channel, through `each`; returns its report and the name of the
+/// environment it ran on (none if `each` did not run the episode).
+fn run_plate<E: ?Sized>(
+    cfg: &UserStudyConfig,
+    ctx: &TaskContext,
+    workload: &Arc<dyn WorkloadModel>,
+    policy: &mut dyn Policy,
+    plate: &Plate,
+    env: &mut E,
+    each: &mut impl FnMut(&Plate, &mut E, &mut Episode<'_>) -> Result<EpisodeReport>,
+) -> Result<(EpisodeReport, Option<String>)> {
+    let mut channel = cfg.channel.build(ctx)?;
+    let mut env_name = None;
+    let mut episode = |env: &mut dyn Environment, observers: &mut [&mut dyn SessionObserver]| {
+        env_name = Some(env.name().to_string());
+        Session::new(
+            cfg.session.clone(),
+            env,
+            &mut *policy,
+            channel.as_mut(),
+            Arc::clone(workload),
+        )
+        .run_episode(plate.seed, observers)
+    };
+    let report = each(plate, env, &mut episode)?;
+    Ok((report, env_name))
+}
+
 /// A built study: every method's policy and the workload model, ready to
 /// run plates on an environment built from the same config.
 pub struct UserStudy<'c> {
@@ -328,22 +357,19 @@ impl UserStudy<'_> {
         let mut foods: Vec<String> = Vec::new();
         let mut env_name = String::new();
         for plate in self.schedule() {
-            let mut channel = cfg.channel.build(&self.ctx)?;
             let policy = self.policies[plate.method].as_mut();
-            let workload = Arc::clone(&self.workload);
-            let mut episode =
-                |env: &mut dyn Environment, observers: &mut [&mut dyn SessionObserver]| {
-                    env_name = env.name().to_string();
-                    Session::new(
-                        cfg.session.clone(),
-                        env,
-                        &mut *policy,
-                        channel.as_mut(),
-                        Arc::clone(&workload),
-                    )
-                    .run_episode(plate.seed, observers)
-                };
-            let report = each(&plate, env, &mut episode)?;
+            let (report, name) = run_plate(
+                cfg,
+                &self.ctx,
+                &self.workload,
+                policy,
+                &plate,
+                env,
+                &mut each,
+            )?;
+            if let Some(name) = name {
+                env_name = name;
+            }
             for e in &report.events {
                 if !foods.contains(&e.step.item_label) {
                     foods.push(e.step.item_label.clone());
@@ -419,21 +445,15 @@ impl UserStudy<'_> {
                         position: i + 1,
                         seed: splitmix(cfg.seed ^ VALIDATION_STREAM, i as u64),
                     };
-                    let mut channel = cfg.channel.build(&self.ctx)?;
-                    let workload = Arc::clone(&self.workload);
-                    let policy = policy.as_mut();
-                    let mut episode =
-                        |env: &mut dyn Environment, observers: &mut [&mut dyn SessionObserver]| {
-                            Session::new(
-                                cfg.session.clone(),
-                                env,
-                                &mut *policy,
-                                channel.as_mut(),
-                                Arc::clone(&workload),
-                            )
-                            .run_episode(plate.seed, observers)
-                        };
-                    let report = each(&plate, env, &mut episode)?;
+                    let (report, _) = run_plate(
+                        cfg,
+                        &self.ctx,
+                        &self.workload,
+                        policy.as_mut(),
+                        &plate,
+                        env,
+                        each,
+                    )?;
                     scores.push(report.metrics.m_wt(v.w_task));
                     queries += report.metrics.n_q;
                 }

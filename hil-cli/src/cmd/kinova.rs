@@ -290,6 +290,15 @@ const PAPER_STUDY: [(&str, f64, f64, f64); 3] = [
 
 /// The study `hil demo kinova` runs: the paper's protocol, changed by
 /// `--components` and then by the flags.
+/// Where the study file's relative paths resolve: its folder, or `.`.
+fn components_dir(args: &KinovaDemoArgs) -> PathBuf {
+    args.components
+        .as_deref()
+        .and_then(Path::parent)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
 fn demo_config(args: &KinovaDemoArgs) -> Result<UserStudyConfig> {
     for (flag, zero) in [
         ("--repetitions", args.repetitions == Some(0)),
@@ -350,12 +359,7 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
         return demo_many_seeds(&args);
     }
     let cfg = demo_config(&args)?;
-    let base = args
-        .components
-        .as_deref()
-        .and_then(Path::parent)
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("."));
+    let base = components_dir(&args);
     let quiet = args.quiet;
     if !quiet {
         eprintln!("building the environment and its pretraining data (once, for every method)");
@@ -534,12 +538,7 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
         ));
     }
     let base_cfg = demo_config(args)?;
-    let base = args
-        .components
-        .as_deref()
-        .and_then(Path::parent)
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("."));
+    let base = components_dir(args);
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))

@@ -65,11 +65,7 @@ fn run(
         let name = o.name().to_string();
         Ok(Box::new(crate::plugin::GuardedChannel::new(o, lib, &name)?) as Box<dyn QueryChannel>)
     });
-    let build_failure = |e: crate::HilError| ConformanceFailure {
-        subject: "<query channel factory>".into(),
-        check: Check::Build,
-        detail: e.to_string(),
-    };
+    let build_failure = |e: crate::HilError| ConformanceFailure::of_factory("query channel", &e);
     opts.validate().map_err(build_failure)?;
     let mut a = make().map_err(build_failure)?;
     let mut c = Checker::new(a.name(), only);

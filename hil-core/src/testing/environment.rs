@@ -64,11 +64,7 @@ fn run(
                 as Box<dyn Environment>,
         )
     });
-    let build_failure = |e: HilError| ConformanceFailure {
-        subject: "<environment factory>".into(),
-        check: Check::Build,
-        detail: e.to_string(),
-    };
+    let build_failure = |e: HilError| ConformanceFailure::of_factory("environment", &e);
     opts.validate().map_err(build_failure)?;
     let mut a = make().map_err(build_failure)?;
     let mut c = Checker::new(a.name(), only);

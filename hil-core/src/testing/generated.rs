@@ -149,10 +149,8 @@ macro_rules! __conformance_tests {
                 let make: &dyn Fn(
                     &$crate::testing::CheckOptions,
                 ) -> $crate::Result<::std::boxed::Box<dyn $crate::WorkloadModel>> = &$make;
-                let model = make(&opts).map_err(|e| $crate::testing::ConformanceFailure {
-                    subject: "<workload model factory>".into(),
-                    check: $crate::testing::Check::Build,
-                    detail: e.to_string(),
+                let model = make(&opts).map_err(|e| {
+                    $crate::testing::ConformanceFailure::of_factory("workload model", &e)
                 })?;
                 $crate::testing::check_workload_model_only(model.as_ref(), &opts, property)
             }

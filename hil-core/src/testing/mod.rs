@@ -192,6 +192,19 @@ pub(crate) fn guarded<T: ?Sized>(
     move || wrap(make()?, under_test())
 }
 
+impl ConformanceFailure {
+    /// A [`Check::Build`] failure: the factory of a `what` (e.g. `policy`)
+    /// under test, or the options it was given, failed before any object
+    /// could be checked.
+    pub fn of_factory(what: &str, e: &HilError) -> Self {
+        Self {
+            subject: format!("<{what} factory>"),
+            check: Check::Build,
+            detail: e.to_string(),
+        }
+    }
+}
+
 /// An error as a failure's detail: a guarded panic is named as one.
 fn describe_error(e: &HilError) -> String {
     match e {

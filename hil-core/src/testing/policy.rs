@@ -13,7 +13,7 @@ type Make<'a> = &'a dyn Fn() -> crate::Result<Box<dyn Policy>>;
 /// options taken from the first instance's shape (its arms and dimension);
 /// see [`check_policy_with`] for the checks.
 pub fn check_policy(make: Make<'_>) -> Result<ConformanceReport, ConformanceFailure> {
-    let probe = make().map_err(|e| build_failure(&e))?;
+    let probe = make().map_err(|e| ConformanceFailure::of_factory("policy", &e))?;
     let (n_arms, dim) = (probe.n_arms(), probe.dim());
     let names: Vec<String> = (0..n_arms).map(|i| format!("arm{i}")).collect();
     let Ok(actions) = ActionSpace::new(names) else {
@@ -60,14 +60,6 @@ pub fn check_policy_only(
     run(make, opts, Some(property))
 }
 
-fn build_failure(e: &HilError) -> ConformanceFailure {
-    ConformanceFailure {
-        subject: "<policy factory>".into(),
-        check: Check::Build,
-        detail: e.to_string(),
-    }
-}
-
 fn run(
     make: Make<'_>,
     opts: &CheckOptions,
@@ -77,8 +69,9 @@ fn run(
         let name = o.name().to_string();
         Ok(Box::new(crate::plugin::GuardedPolicy::new(o, lib, &name)?) as Box<dyn Policy>)
     });
-    opts.validate().map_err(|e| build_failure(&e))?;
-    let first = make().map_err(|e| build_failure(&e))?;
+    opts.validate()
+        .map_err(|e| ConformanceFailure::of_factory("policy", &e))?;
+    let first = make().map_err(|e| ConformanceFailure::of_factory("policy", &e))?;
     let mut c = Checker::new(first.name(), only);
     drop(first);
     let build = |c: &Checker| c.ok(Check::Build, make());

@@ -297,26 +297,12 @@ impl Response {
 
     /// A response choosing `arm`.
     pub fn action(arm: ArmId) -> Self {
-        Self {
-            answer: Answer::Action { arm },
-            expert_arm: Some(arm),
-            response_time_s: None,
-        }
+        Self::new(Answer::Action { arm }, Some(arm), None)
     }
 
     /// A response with no usable action.
     pub fn without_action(answer: Answer) -> Self {
-        Self {
-            answer,
-            expert_arm: None,
-            response_time_s: None,
-        }
-    }
-
-    /// With the robot action the answer implies (e.g. a label mapped to an arm).
-    pub fn with_expert_arm(mut self, arm: ArmId) -> Self {
-        self.expert_arm = Some(arm);
-        self
+        Self::new(answer, None, None)
     }
 
     /// With the seconds the person took to answer.

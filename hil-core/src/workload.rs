@@ -149,11 +149,6 @@ impl<'a> WorkloadInput<'a> {
             t: self.t,
         }
     }
-
-    /// The same question at another timestep.
-    pub fn at(&self, t: Timestep) -> Self {
-        Self { t, ..*self }
-    }
 }
 
 /// A model of querying workload: WL_t = f(WL_0, Q_t).

@@ -1,0 +1,3 @@
+"""Type stubs of the native module `hil._hil`."""
+
+__version__: str

@@ -6,9 +6,16 @@
 
 use pyo3::prelude::*;
 
+mod errors;
+mod gym;
+mod sweep;
+
 /// The native module. The Python package re-exports its public names.
 #[pymodule]
 fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    errors::register(m)?;
+    gym::register(m)?;
+    sweep::register(m)?;
     Ok(())
 }

@@ -1,0 +1,811 @@
+//! hil's own components from Python: `hil.Policy`, `hil.Environment`,
+//! `hil.QueryChannel` and `hil.WorkloadModel`, each built from a config
+//! (its `type` and parameters, exactly as in an experiment TOML, so every
+//! built-in and registered type is reachable), and the conversion of any
+//! component argument (one of these, or a Python object with the right
+//! methods) into the trait object hil's loop takes.
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use hil_core::config::{
+    EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig,
+};
+use hil_core::{
+    ActionSpace, ArmId, BuildContext, Context, Decision, DecisionInput, Environment, Feedback,
+    HilError, Item, LabelledObservation, Outcome, Policy, Query, QueryChannel, QueryHistory,
+    QueryKind, Response, Result, TaskContext, WorkloadForecast, WorkloadInput, WorkloadModel,
+};
+use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use serde_json::Value;
+
+use crate::convert::{from_py, to_py};
+use crate::errors::{IntoPy, to_py_err};
+use crate::pycomponents::{PyChannel, PyEnvironment, PyPolicy, PyWorkload};
+
+/// A component table (`{"type": ..., **params}`) from a type name and
+/// keyword parameters.
+pub(crate) fn table(ty: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<Value> {
+    let mut v = match params {
+        Some(p) => from_py::<Value>(p.as_any(), "parameters")?,
+        None => Value::Object(Default::default()),
+    };
+    match v.as_object_mut() {
+        Some(o) => {
+            o.insert("type".into(), Value::String(ty.into()));
+        }
+        None => unreachable!("keyword arguments are a dict"),
+    }
+    Ok(v)
+}
+
+/// Parses a component table as the config of one of the four kinds
+/// (built-in or registered type), then runs its `validate`.
+macro_rules! parse_config {
+    ($fn:ident, $trait:ident) => {
+        pub(crate) fn $fn(v: Value) -> Result<Box<dyn $trait>> {
+            let ty = v
+                .get("type")
+                .and_then(Value::as_str)
+                .unwrap_or("?")
+                .to_string();
+            let cfg: Box<dyn $trait> = hil_core::plugin::component(v)
+                .map_err(|e| HilError::serde(format!("config of `{ty}`"), e))?;
+            cfg.validate()?;
+            Ok(cfg)
+        }
+    };
+}
+parse_config!(policy_config, PolicyConfig);
+parse_config!(environment_config, EnvironmentConfig);
+parse_config!(workload_config, WorkloadModelConfig);
+parse_config!(channel_config, QueryChannelConfig);
+
+/// `actions` as an action space: a count (`a0`, `a1`, ...) or names.
+fn action_space(actions: &Bound<'_, PyAny>) -> PyResult<ActionSpace> {
+    let names: Vec<String> = match actions.extract::<usize>() {
+        Ok(n) => (0..n).map(|i| format!("a{i}")).collect(),
+        Err(_) => actions.extract()?,
+    };
+    ActionSpace::new(names).py_err()
+}
+
+/// Locks `m`, also after a panic elsewhere (the guard reported it).
+fn lock<T: ?Sized>(m: &Mutex<Box<T>>) -> MutexGuard<'_, Box<T>> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+// ---------------------------------------------------------------- policies
+
+/// A hil policy (any built-in or registered type).
+///
+/// Built from its type and hyperparameters, validated: e.g.
+/// `Policy("linucb_qg", actions=6, dim=8, alpha=0.5, w=1.0)`. Bad values
+/// raise `InvalidParameterError` naming the parameter. The environment's
+/// facts come from `environment=` (which also gives pretraining data when
+/// `pretrain=True`), or from `actions=` (a count or names) and `dim=`
+/// (with `pretraining=(X, arms, rewards)` arrays if wanted).
+#[pyclass(module = "hil._hil", name = "Policy")]
+pub(crate) struct PyPolicyHandle {
+    pub(crate) inner: Arc<Mutex<Box<dyn Policy>>>,
+    name: String,
+    n_arms: usize,
+    dim: usize,
+}
+
+impl PyPolicyHandle {
+    fn new(policy: Box<dyn Policy>) -> Self {
+        Self {
+            name: policy.name().to_string(),
+            n_arms: policy.n_arms(),
+            dim: policy.dim(),
+            inner: Arc::new(Mutex::new(policy)),
+        }
+    }
+}
+
+/// The build context of a policy or channel from the Python arguments.
+pub(crate) fn task_context(
+    py: Python<'_>,
+    environment: Option<&Bound<'_, PyEnvironmentHandle>>,
+    actions: Option<&Bound<'_, PyAny>>,
+    dim: Option<usize>,
+    pretraining: Option<&Bound<'_, PyAny>>,
+    seed: u64,
+) -> PyResult<TaskContext> {
+    if let Some(env) = environment {
+        let env = env.borrow();
+        let ctx = BuildContext::new(env.base_dir.clone(), seed);
+        let built = lock(&env.inner);
+        let task = match &env.config {
+            Some(cfg) => ctx.describe_environment(cfg.as_ref(), built.as_ref()),
+            None => Ok(TaskContext::new(
+                ctx,
+                built.action_space().clone(),
+                built.context_dim(),
+            )),
+        };
+        return task.py_err();
+    }
+    let (Some(actions), Some(dim)) = (actions, dim) else {
+        return Err(to_py_err(HilError::invalid_input(
+            "arguments",
+            "give `environment=`, or both `actions=` and `dim=`",
+        )));
+    };
+    let task = TaskContext::new(BuildContext::new(".", seed), action_space(actions)?, dim);
+    match pretraining {
+        None => Ok(task),
+        Some(p) => {
+            let (x, arms, rewards): (
+                PyReadonlyArray2<'_, f64>,
+                PyReadonlyArray1<'_, i64>,
+                PyReadonlyArray1<'_, f64>,
+            ) = p.extract()?;
+            let (x, arms, rewards) = (x.as_array(), arms.as_array(), rewards.as_array());
+            if x.nrows() != arms.len() || x.nrows() != rewards.len() {
+                return Err(to_py_err(HilError::invalid_input(
+                    "pretraining",
+                    format!(
+                        "X has {} rows, arms {} and rewards {}",
+                        x.nrows(),
+                        arms.len(),
+                        rewards.len()
+                    ),
+                )));
+            }
+            let mut data = Vec::with_capacity(x.nrows());
+            for (i, row) in x.rows().into_iter().enumerate() {
+                let arm = usize::try_from(arms[i]).map_err(|_| {
+                    to_py_err(HilError::invalid_input(
+                        format!("pretraining arms[{i}]"),
+                        format!("{} is negative", arms[i]),
+                    ))
+                })?;
+                data.push(LabelledObservation {
+                    context: Context::new(row.to_vec()).py_err()?,
+                    arm: ArmId(arm),
+                    reward: rewards[i],
+                });
+            }
+            let _ = py;
+            Ok(task.with_pretraining(data.into()))
+        }
+    }
+}
+
+#[pymethods]
+impl PyPolicyHandle {
+    #[new]
+    #[pyo3(signature = (r#type, /, *, environment=None, actions=None, dim=None, pretraining=None, seed=0, **params))]
+    #[allow(clippy::too_many_arguments)]
+    fn py_new(
+        py: Python<'_>,
+        r#type: &str,
+        environment: Option<&Bound<'_, PyEnvironmentHandle>>,
+        actions: Option<&Bound<'_, PyAny>>,
+        dim: Option<usize>,
+        pretraining: Option<&Bound<'_, PyAny>>,
+        seed: u64,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let cfg = policy_config(table(r#type, params)?).py_err()?;
+        let ctx = task_context(py, environment, actions, dim, pretraining, seed)?;
+        let policy = py.detach(|| cfg.build(&ctx)).py_err()?;
+        Ok(Self::new(policy))
+    }
+
+    /// The policy's short name (e.g. `linucb_qg`).
+    #[getter]
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Number of robot actions.
+    #[getter]
+    fn n_arms(&self) -> usize {
+        self.n_arms
+    }
+
+    /// Context dimension.
+    #[getter]
+    fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Reseeds the policy's own randomness.
+    fn seed(&self, seed: u64) {
+        lock(&self.inner).seed(seed);
+    }
+
+    /// Decides for `context` (1-d float array) at timestep `t`: returns the
+    /// `Decision` as a dict (`choice`: `{"type": "act", "arm": k}` or
+    /// `{"type": "query", "kind": ..., "fallback": k}`; `diagnostics`).
+    /// `workload` (a `WorkloadModel`) backs the forecast that LinUCB-QG
+    /// weighs, with initial workload `wl0` and the times of the queries
+    /// asked so far (`query_times`).
+    #[pyo3(signature = (context, t=1, *, item_index=0, items_seen=0, attempt=0, workload=None, wl0=0.5, query_times=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn decide(
+        &self,
+        py: Python<'_>,
+        context: PyReadonlyArray1<'_, f64>,
+        t: u64,
+        item_index: usize,
+        items_seen: usize,
+        attempt: u32,
+        workload: Option<&Bound<'_, PyWorkloadHandle>>,
+        wl0: f64,
+        query_times: Option<Vec<u64>>,
+    ) -> PyResult<Py<PyAny>> {
+        let x = crate::convert::context(context)?;
+        let history = history_of(query_times.as_deref())?;
+        let model = workload.map(|w| w.borrow().inner.clone());
+        let decision: Decision = py
+            .detach(|| {
+                let forecast = WorkloadForecast::new(model.as_deref(), wl0, &history, t);
+                let input = DecisionInput::new(&x, t, forecast).at_item(item_index, items_seen, attempt);
+                lock(&self.inner).decide(&input)
+            })
+            .py_err()?;
+        to_py(py, &decision, "decision")
+    }
+
+    /// Learns from executing `arm` in `context` with `reward` at `t`
+    /// (`from_expert`: the arm was the person's answer).
+    #[pyo3(signature = (context, arm, reward, t=1, *, from_expert=false))]
+    fn observe(
+        &self,
+        py: Python<'_>,
+        context: PyReadonlyArray1<'_, f64>,
+        arm: usize,
+        reward: f64,
+        t: u64,
+        from_expert: bool,
+    ) -> PyResult<()> {
+        let x = crate::convert::context(context)?;
+        py.detach(|| {
+            let f = Feedback::new(&x, ArmId(arm), reward, t).from_expert(from_expert);
+            lock(&self.inner).observe(&f)
+        })
+        .py_err()
+    }
+
+    /// The full learning state as a JSON string (estimates, RNG, counters).
+    fn save(&self, py: Python<'_>) -> PyResult<String> {
+        let state = py.detach(|| lock(&self.inner).save()).py_err()?;
+        serde_json::to_string(&state)
+            .map_err(|e| HilError::serde("policy state", e))
+            .py_err()
+    }
+
+    /// Restores a state from `save()` (a JSON string or its parsed form).
+    fn restore(&self, py: Python<'_>, state: &Bound<'_, PyAny>) -> PyResult<()> {
+        let value: Value = match state.extract::<String>() {
+            Ok(text) => serde_json::from_str(&text)
+                .map_err(|e| HilError::serde("policy state", e))
+                .py_err()?,
+            Err(_) => from_py(state, "policy state")?,
+        };
+        py.detach(|| lock(&self.inner).restore(value)).py_err()
+    }
+
+    /// The diagnostics of a decision for `context` as a dict (per-arm
+    /// estimate, bonus and UCB; gap, threshold, query probability,
+    /// workload forecast where the policy computes them), without
+    /// changing what the policy will decide next... for deterministic
+    /// policies; a stochastic one draws from its RNG.
+    #[pyo3(signature = (context, t=1, *, workload=None, wl0=0.5, query_times=None))]
+    fn diagnostics(
+        &self,
+        py: Python<'_>,
+        context: PyReadonlyArray1<'_, f64>,
+        t: u64,
+        workload: Option<&Bound<'_, PyWorkloadHandle>>,
+        wl0: f64,
+        query_times: Option<Vec<u64>>,
+    ) -> PyResult<Py<PyAny>> {
+        let d = self.decide(py, context, t, 0, 0, 0, workload, wl0, query_times)?;
+        Ok(d.bind(py).get_item("diagnostics")?.unbind())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Policy({:?}, n_arms={}, dim={})",
+            self.name, self.n_arms, self.dim
+        )
+    }
+}
+
+fn history_of(times: Option<&[u64]>) -> PyResult<QueryHistory> {
+    let mut h = QueryHistory::new();
+    for &t in times.unwrap_or(&[]) {
+        h.push(t, QueryKind::default()).py_err()?;
+    }
+    Ok(h)
+}
+
+/// A shared hil policy as a trait object: every call locks it, so the
+/// Python handle sees what the loop taught it.
+struct SharedPolicy {
+    inner: Arc<Mutex<Box<dyn Policy>>>,
+    name: String,
+    n_arms: usize,
+    dim: usize,
+}
+
+impl Policy for SharedPolicy {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn n_arms(&self) -> usize {
+        self.n_arms
+    }
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn seed(&mut self, seed: u64) {
+        lock(&self.inner).seed(seed)
+    }
+    fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
+        lock(&self.inner).decide(input)
+    }
+    fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()> {
+        lock(&self.inner).observe(feedback)
+    }
+    fn save(&self) -> Result<Value> {
+        lock(&self.inner).save()
+    }
+    fn restore(&mut self, state: Value) -> Result<()> {
+        lock(&self.inner).restore(state)
+    }
+}
+
+/// A policy argument: a `hil.Policy` (shared) or a Python object with the
+/// policy methods.
+pub(crate) fn policy_arg(obj: &Bound<'_, PyAny>) -> PyResult<Box<dyn Policy>> {
+    if let Ok(h) = obj.cast::<PyPolicyHandle>() {
+        let h = h.borrow();
+        return Ok(Box::new(SharedPolicy {
+            inner: h.inner.clone(),
+            name: h.name.clone(),
+            n_arms: h.n_arms,
+            dim: h.dim,
+        }));
+    }
+    Ok(Box::new(PyPolicy::new(obj.py(), obj.clone().unbind())?))
+}
+
+// ------------------------------------------------------------ environments
+
+/// A hil environment (any built-in or registered type), e.g. the dataset
+/// replay `Environment("food_replay", foods=[...], pretrain_foods=[...])`.
+/// Relative paths in the parameters resolve against `base_dir`.
+#[pyclass(module = "hil._hil", name = "Environment")]
+pub(crate) struct PyEnvironmentHandle {
+    pub(crate) inner: Arc<Mutex<Box<dyn Environment>>>,
+    pub(crate) config: Option<Arc<dyn EnvironmentConfig>>,
+    pub(crate) base_dir: PathBuf,
+    name: String,
+    actions: ActionSpace,
+    dim: usize,
+}
+
+#[pymethods]
+impl PyEnvironmentHandle {
+    #[new]
+    #[pyo3(signature = (r#type, /, *, seed=0, base_dir=None, **params))]
+    fn py_new(
+        py: Python<'_>,
+        r#type: &str,
+        seed: u64,
+        base_dir: Option<PathBuf>,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let cfg: Arc<dyn EnvironmentConfig> =
+            Arc::from(environment_config(table(r#type, params)?).py_err()?);
+        let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
+        let ctx = BuildContext::new(base_dir.clone(), seed);
+        let env = py.detach(|| cfg.build(&ctx)).py_err()?;
+        Ok(Self {
+            name: env.name().to_string(),
+            actions: env.action_space().clone(),
+            dim: env.context_dim(),
+            inner: Arc::new(Mutex::new(env)),
+            config: Some(cfg),
+            base_dir,
+        })
+    }
+
+    /// The environment's short name.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The names of the robot actions.
+    #[getter]
+    fn actions(&self) -> Vec<String> {
+        self.actions.names().to_vec()
+    }
+
+    /// Context dimension.
+    #[getter]
+    fn context_dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Starts an episode seeded by `seed`.
+    fn reset(&self, py: Python<'_>, seed: u64) -> PyResult<()> {
+        py.detach(|| lock(&self.inner).reset(seed)).py_err()
+    }
+
+    /// The next item as a dict (`index`, `label`, `description`), or None
+    /// at the end of the episode.
+    fn next_item(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let item: Option<Item> = py.detach(|| lock(&self.inner).next_item()).py_err()?;
+        to_py(py, &item, "item")
+    }
+
+    /// A fresh context of the current item (1-d float array).
+    fn observe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let x = py.detach(|| lock(&self.inner).observe()).py_err()?;
+        Ok(crate::convert::array(py, &x))
+    }
+
+    /// Executes `arm`; returns the `Outcome` as a dict (`success`,
+    /// `success_probability`, ...).
+    fn execute(&self, py: Python<'_>, arm: usize) -> PyResult<Py<PyAny>> {
+        let o: Outcome = py.detach(|| lock(&self.inner).execute(ArmId(arm))).py_err()?;
+        to_py(py, &o, "outcome")
+    }
+
+    /// The best action for the current observation, if known (simulation).
+    fn best_action(&self) -> Option<usize> {
+        lock(&self.inner).best_action().map(|a| a.0)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Environment({:?}, actions={}, context_dim={})",
+            self.name,
+            self.actions.len(),
+            self.dim
+        )
+    }
+}
+
+struct SharedEnvironment {
+    inner: Arc<Mutex<Box<dyn Environment>>>,
+    name: String,
+    actions: ActionSpace,
+    dim: usize,
+    item: Option<Item>,
+}
+
+impl Environment for SharedEnvironment {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn action_space(&self) -> &ActionSpace {
+        &self.actions
+    }
+    fn context_dim(&self) -> usize {
+        self.dim
+    }
+    fn reset(&mut self, seed: u64) -> Result<()> {
+        self.item = None;
+        lock(&self.inner).reset(seed)
+    }
+    fn next_item(&mut self) -> Result<Option<Item>> {
+        let item = lock(&self.inner).next_item()?;
+        self.item = item.clone();
+        Ok(item)
+    }
+    fn observe(&mut self) -> Result<Context> {
+        lock(&self.inner).observe()
+    }
+    fn execute(&mut self, arm: ArmId) -> Result<Outcome> {
+        lock(&self.inner).execute(arm)
+    }
+    fn best_action(&self) -> Option<ArmId> {
+        lock(&self.inner).best_action()
+    }
+    fn current_item(&self) -> Option<&Item> {
+        self.item.as_ref()
+    }
+}
+
+/// An environment argument: a `hil.Environment` (shared) or a Python
+/// object with the environment methods; with its config when it has one
+/// (for pretraining data).
+pub(crate) fn environment_arg(
+    obj: &Bound<'_, PyAny>,
+) -> PyResult<(Box<dyn Environment>, Option<Arc<dyn EnvironmentConfig>>)> {
+    if let Ok(h) = obj.cast::<PyEnvironmentHandle>() {
+        let h = h.borrow();
+        let env = SharedEnvironment {
+            inner: h.inner.clone(),
+            name: h.name.clone(),
+            actions: h.actions.clone(),
+            dim: h.dim,
+            item: None,
+        };
+        return Ok((Box::new(env), h.config.clone()));
+    }
+    Ok((Box::new(PyEnvironment::new(obj.py(), obj.clone().unbind())?), None))
+}
+
+// ---------------------------------------------------------- query channels
+
+/// A hil query channel (any built-in or registered type), e.g.
+/// `QueryChannel("simulated_expert", error_rate=0.1)` (built for
+/// `environment=`, or `actions=` and `dim=`).
+#[pyclass(module = "hil._hil", name = "QueryChannel")]
+pub(crate) struct PyChannelHandle {
+    inner: Arc<Mutex<Box<dyn QueryChannel>>>,
+    name: String,
+}
+
+#[pymethods]
+impl PyChannelHandle {
+    #[new]
+    #[pyo3(signature = (r#type, /, *, environment=None, actions=None, dim=None, seed=0, **params))]
+    fn py_new(
+        py: Python<'_>,
+        r#type: &str,
+        environment: Option<&Bound<'_, PyEnvironmentHandle>>,
+        actions: Option<&Bound<'_, PyAny>>,
+        dim: Option<usize>,
+        seed: u64,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let cfg = channel_config(table(r#type, params)?).py_err()?;
+        let ctx = task_context(py, environment, actions, dim, None, seed)?;
+        let ch = cfg.build(&ctx).py_err()?;
+        Ok(Self {
+            name: ch.name().to_string(),
+            inner: Arc::new(Mutex::new(ch)),
+        })
+    }
+
+    /// The channel's short name.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Reseeds a simulated channel.
+    fn seed(&self, seed: u64) {
+        lock(&self.inner).seed(seed)
+    }
+
+    /// Asks `query` (the serde form of a `Query` as a dict) and returns the
+    /// `Response` as a dict.
+    fn ask(&self, py: Python<'_>, query: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        let q: Query = from_py(query, "query")?;
+        let r: Response = py.detach(|| lock(&self.inner).ask(&q)).py_err()?;
+        to_py(py, &r, "response")
+    }
+}
+
+struct SharedChannel {
+    inner: Arc<Mutex<Box<dyn QueryChannel>>>,
+    name: String,
+}
+
+impl QueryChannel for SharedChannel {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn seed(&mut self, seed: u64) {
+        lock(&self.inner).seed(seed)
+    }
+    fn endpoint(&self) -> Option<String> {
+        lock(&self.inner).endpoint()
+    }
+    fn ask(&mut self, query: &Query) -> Result<Response> {
+        lock(&self.inner).ask(query)
+    }
+}
+
+/// A channel argument: a `hil.QueryChannel`, a Python object with `ask`,
+/// or None for the perfect expert of the paper's simulations.
+pub(crate) fn channel_arg(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Box<dyn QueryChannel>> {
+    let Some(obj) = obj else {
+        return Ok(Box::new(hil_core::PerfectExpert::default()));
+    };
+    if let Ok(h) = obj.cast::<PyChannelHandle>() {
+        let h = h.borrow();
+        return Ok(Box::new(SharedChannel {
+            inner: h.inner.clone(),
+            name: h.name.clone(),
+        }));
+    }
+    Ok(Box::new(PyChannel::new(obj.py(), obj.clone().unbind())))
+}
+
+// --------------------------------------------------------- workload models
+
+/// A workload model WL_t = f(WL_0, Q_t): `WorkloadModel.bundled("f2_sim")`,
+/// `WorkloadModel.from_file(path)`, `hil.fit_workload(...)`, or any
+/// registered type: `WorkloadModel("demo_counting", step=0.1)`.
+#[pyclass(module = "hil._hil", name = "WorkloadModel", frozen)]
+pub(crate) struct PyWorkloadHandle {
+    pub(crate) inner: Arc<dyn WorkloadModel>,
+}
+
+impl PyWorkloadHandle {
+    pub(crate) fn of(inner: Arc<dyn WorkloadModel>) -> Self {
+        Self { inner }
+    }
+}
+
+/// Query kinds from their display strings (`mcq`, `open/hard`, ...), one
+/// per query time; all the default kind when None.
+fn kinds_of(kinds: Option<Vec<String>>, n: usize) -> PyResult<Vec<QueryKind>> {
+    match kinds {
+        None => Ok(vec![QueryKind::default(); n]),
+        Some(k) => {
+            if k.len() != n {
+                return Err(to_py_err(HilError::invalid_input(
+                    "kinds",
+                    format!("{} kinds for {n} query times", k.len()),
+                )));
+            }
+            k.iter()
+                .map(|s| {
+                    s.parse::<QueryKind>()
+                        .map_err(|e| to_py_err(HilError::invalid_input("kinds", e.to_string())))
+                })
+                .collect()
+        }
+    }
+}
+
+#[pymethods]
+impl PyWorkloadHandle {
+    #[new]
+    #[pyo3(signature = (r#type, /, *, base_dir=None, **params))]
+    fn py_new(
+        py: Python<'_>,
+        r#type: &str,
+        base_dir: Option<PathBuf>,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let cfg = workload_config(table(r#type, params)?).py_err()?;
+        let ctx = BuildContext::new(base_dir.unwrap_or_else(|| ".".into()), 0);
+        Ok(Self::of(py.detach(|| cfg.build(&ctx)).py_err()?))
+    }
+
+    /// A model bundled with hil (`f1_sim`, `f2_sim`, `f12_sim`, their
+    /// `_steep` ends, `f1_real`, `f12_real`; synthetic, calibrated to
+    /// published figures).
+    #[staticmethod]
+    fn bundled(name: &str) -> PyResult<Self> {
+        Ok(Self::of(hil_workload::bundled::load(name).py_err()?))
+    }
+
+    /// The names of the bundled models.
+    #[staticmethod]
+    fn bundled_names() -> Vec<String> {
+        hil_workload::bundled::NAMES
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    /// A model JSON file written by `hil workload fit` or `fit_workload`.
+    #[staticmethod]
+    fn from_file(path: PathBuf) -> PyResult<Self> {
+        Ok(Self::of(hil_workload::load_model_json(path).py_err()?))
+    }
+
+    /// The model's short name.
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name().to_string()
+    }
+
+    /// WL_t from the initial workload `wl0` and the queries asked at
+    /// `query_times` (with `kinds`, e.g. `"mcq"`, default the easy
+    /// multiple-choice query), at timestep `t`.
+    #[pyo3(signature = (wl0, query_times, t, kinds=None))]
+    fn predict(
+        &self,
+        wl0: f64,
+        query_times: Vec<u64>,
+        t: u64,
+        kinds: Option<Vec<String>>,
+    ) -> PyResult<f64> {
+        let h = history_with(&query_times, kinds)?;
+        self.inner.predict(&WorkloadInput::new(wl0, &h, t)).py_err()
+    }
+
+    /// WL_t if a query of `kind` were asked now, at `t`.
+    #[pyo3(signature = (wl0, query_times, t, kinds=None, kind=None))]
+    fn predict_if_queried(
+        &self,
+        wl0: f64,
+        query_times: Vec<u64>,
+        t: u64,
+        kinds: Option<Vec<String>>,
+        kind: Option<String>,
+    ) -> PyResult<f64> {
+        let h = history_with(&query_times, kinds)?;
+        let kind = kinds_of(kind.map(|k| vec![k]), 1)?[0];
+        self.inner
+            .predict_if_queried(&WorkloadInput::new(wl0, &h, t), kind)
+            .py_err()
+    }
+
+    /// WL_t at every t in 0..=steps (a 1-d array) for queries asked at
+    /// `query_times` (`kinds` as in `predict`); WL_0 at t = 0. Steps are
+    /// Δt = 10 s.
+    #[pyo3(signature = (query_times, steps=None, *, wl0=0.5, kinds=None))]
+    fn rollout<'py>(
+        &self,
+        py: Python<'py>,
+        query_times: Vec<u64>,
+        steps: Option<u64>,
+        wl0: f64,
+        kinds: Option<Vec<String>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        hil_core::workload::check_wl0(wl0).py_err()?;
+        let kinds = kinds_of(kinds, query_times.len())?;
+        let end = steps.unwrap_or(query_times.iter().max().copied().unwrap_or(0) + 10);
+        let mut order: Vec<(u64, QueryKind)> = query_times.into_iter().zip(kinds).collect();
+        order.sort_by_key(|q| q.0);
+        let model = self.inner.clone();
+        let curve = py
+            .detach(|| -> Result<Vec<f64>> {
+                let mut h = QueryHistory::new();
+                let mut next = order.into_iter().peekable();
+                let mut out = Vec::with_capacity(end as usize + 1);
+                for t in 0..=end {
+                    while let Some((_, kind)) = next.next_if(|q| q.0 == t) {
+                        h.push(t, kind)?;
+                    }
+                    out.push(hil_core::workload::workload_at(model.as_ref(), wl0, &h, t)?);
+                }
+                Ok(out)
+            })
+            .py_err()?;
+        Ok(PyArray1::from_vec(py, curve))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("WorkloadModel({:?})", self.inner.name())
+    }
+}
+
+fn history_with(times: &[u64], kinds: Option<Vec<String>>) -> PyResult<QueryHistory> {
+    let kinds = kinds_of(kinds, times.len())?;
+    let mut h = QueryHistory::new();
+    for (&t, k) in times.iter().zip(kinds) {
+        h.push(t, k).py_err()?;
+    }
+    Ok(h)
+}
+
+/// A workload-model argument: a `hil.WorkloadModel`, a bundled model's
+/// name, or a Python object with `predict`.
+pub(crate) fn workload_arg(obj: &Bound<'_, PyAny>) -> PyResult<Arc<dyn WorkloadModel>> {
+    if let Ok(h) = obj.cast::<PyWorkloadHandle>() {
+        return Ok(h.get().inner.clone());
+    }
+    if let Ok(name) = obj.cast::<PyString>() {
+        return hil_workload::bundled::load(&name.to_cow()?).py_err();
+    }
+    Ok(Arc::new(PyWorkload::new(obj.py(), obj.clone().unbind())))
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyPolicyHandle>()?;
+    m.add_class::<PyEnvironmentHandle>()?;
+    m.add_class::<PyChannelHandle>()?;
+    m.add_class::<PyWorkloadHandle>()?;
+    Ok(())
+}

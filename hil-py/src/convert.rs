@@ -1,0 +1,49 @@
+//! Rust values to plain Python data and back, through their serde form
+//! (JSON), so that every result shape has one definition: the Rust type's.
+
+use hil_core::{Context, HilError};
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyModule;
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+use crate::errors::IntoPy;
+
+/// `value`'s serde form as plain Python data (dicts, lists, numbers, str).
+pub(crate) fn to_py<T: Serialize + ?Sized>(py: Python<'_>, value: &T, what: &str) -> PyResult<Py<PyAny>> {
+    let text = serde_json::to_string(value)
+        .map_err(|e| HilError::serde(what, e))
+        .py_err()?;
+    let json = PyModule::import(py, "json")?;
+    Ok(json.call_method1("loads", (text,))?.unbind())
+}
+
+/// Plain Python data (anything `json.dumps` accepts) as a `T`, through its
+/// serde form; an error names `what`.
+pub(crate) fn from_py<T: DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<T> {
+    let text = json_text(obj)?;
+    serde_json::from_str(&text)
+        .map_err(|e| HilError::serde(what, e))
+        .py_err()
+}
+
+/// `json.dumps(obj)`.
+pub(crate) fn json_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    let json = PyModule::import(obj.py(), "json")?;
+    json.call_method1("dumps", (obj,))?.extract()
+}
+
+/// A context from a 1-d float array (or anything NumPy converts to one).
+pub(crate) fn context(array: PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
+    let values: Vec<f64> = match array.as_slice() {
+        Ok(s) => s.to_vec(),
+        Err(_) => array.as_array().iter().copied().collect(),
+    };
+    Context::new(values).py_err()
+}
+
+/// A context as a new 1-d float array.
+pub(crate) fn array<'py>(py: Python<'py>, context: &Context) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, context.as_slice())
+}

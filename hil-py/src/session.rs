@@ -1,0 +1,188 @@
+//! The session loop from Python, with its interaction record and resume,
+//! as `hil run` drives it: from an experiment file (`hil.run`,
+//! `hil.resume`) or from components given in code (`hil.run_session`,
+//! any of them Python objects). The GIL is released while it runs.
+
+use std::path::{Path, PathBuf};
+
+use hil_core::record::{Header, RecordLog, run_recorded};
+use hil_core::{
+    EventCollector, Experiment, ExperimentConfig, ExperimentSummary, HilError, SessionObserver,
+    SessionSettings,
+};
+use pyo3::prelude::*;
+
+use crate::components::{channel_arg, environment_arg, policy_arg, workload_arg};
+use crate::convert::to_py;
+use crate::errors::IntoPy;
+
+/// The config text a component session's log header holds: its
+/// components were given in code, so a resume gives them again.
+const CODE_SESSION: &str = "# a session whose components were given in Python code (hil.run_session)\n";
+
+/// Runs `exp` (recording to `log` if given; continuing the session logged
+/// in `resume` if given) with the GIL released.
+fn drive(
+    py: Python<'_>,
+    exp: &mut Experiment,
+    header_text: &str,
+    config_path: PathBuf,
+    base: PathBuf,
+    log: Option<PathBuf>,
+    resume: Option<PathBuf>,
+    events: bool,
+) -> PyResult<Py<PyAny>> {
+    let mut collector = EventCollector::default();
+    let summary: ExperimentSummary = py
+        .detach(|| {
+            let mut observers: Vec<&mut dyn SessionObserver> = Vec::new();
+            if events {
+                observers.push(&mut collector);
+            }
+            match (log, resume) {
+                (_, Some(path)) => {
+                    let (log, logged) = RecordLog::open(&path)?;
+                    run_recorded(exp, log, Some(&logged), &mut observers, |_, _| {})
+                }
+                (Some(path), None) => {
+                    let header = Header::new(header_text, config_path, base, exp.seed, exp.episodes);
+                    let log = RecordLog::create(&path, header)?;
+                    run_recorded(exp, log, None, &mut observers, |_, _| {})
+                }
+                (None, None) => exp.run(&mut observers, |_, _| {}),
+            }
+        })
+        .py_err()?;
+    let out = to_py(py, &summary, "summary")?;
+    if events {
+        out.bind(py)
+            .set_item("events", to_py(py, &collector.events, "step events")?)?;
+    }
+    Ok(out)
+}
+
+/// Runs the experiment file `config` (TOML, as `hil run --config`) and
+/// returns its summary (the serde form of `ExperimentSummary`: per-episode
+/// metrics, means and standard deviations). With `log`, every step is
+/// recorded in that interaction log (it must not exist yet), so a killed
+/// run continues with `resume(log)`. With `events=True` the summary also
+/// holds every step event.
+#[pyfunction]
+#[pyo3(signature = (config, *, log=None, events=false))]
+pub(crate) fn run(
+    py: Python<'_>,
+    config: PathBuf,
+    log: Option<PathBuf>,
+    events: bool,
+) -> PyResult<Py<PyAny>> {
+    let text = hil_core::files::read_text(&config, hil_core::files::limits::CONFIG).py_err()?;
+    let cfg = ExperimentConfig::parse(&text, &config)
+        .map_err(HilError::from)
+        .py_err()?;
+    let config_abs = std::path::absolute(&config)
+        .map_err(|e| HilError::io("resolving", &config, e))
+        .py_err()?;
+    let base = config_abs
+        .parent()
+        .map_or_else(|| config_abs.clone(), Path::to_path_buf);
+    let mut exp = py.detach(|| cfg.build(&base)).py_err()?;
+    drive(py, &mut exp, &text, config_abs, base, log, None, events)
+}
+
+/// Continues the session recorded in `log` by `run(config, log=...)` (after
+/// a crash, a kill or an interrupt): the config comes from the log,
+/// answered queries are not asked again, new steps are appended. Returns
+/// the summary of the whole session.
+#[pyfunction]
+#[pyo3(signature = (log, *, events=false))]
+pub(crate) fn resume(py: Python<'_>, log: PathBuf, events: bool) -> PyResult<Py<PyAny>> {
+    let header = {
+        let (_, logged) = RecordLog::open(&log).py_err()?;
+        logged.header
+    };
+    if header.config == CODE_SESSION {
+        return Err(crate::errors::to_py_err(HilError::invalid_input(
+            "log",
+            format!(
+                "{} records a session whose components were given in code: resume it with run_session(..., resume=LOG) and the same components",
+                log.display()
+            ),
+        )));
+    }
+    let cfg = ExperimentConfig::parse(&header.config, &header.config_path)
+        .map_err(HilError::from)
+        .py_err()?;
+    let mut exp = py.detach(|| cfg.build(&header.base_dir)).py_err()?;
+    drive(
+        py,
+        &mut exp,
+        &header.config,
+        header.config_path.clone(),
+        header.base_dir.clone(),
+        None,
+        Some(log),
+        events,
+    )
+}
+
+/// Runs `episodes` episodes of hil's session loop over components given in
+/// code, each a hil object (`hil.Policy`, `hil.Environment`,
+/// `hil.QueryChannel`, `hil.WorkloadModel` or a bundled model's name) or
+/// a Python object with the right methods. `channel=None` is the paper's
+/// perfect expert; `forecast` is the model the policy forecasts with, if
+/// not `workload`. Returns the summary as `run` does. `log` records every
+/// step; `resume=LOG` continues a session so recorded, given the same
+/// components.
+#[pyfunction]
+#[pyo3(signature = (*, environment, policy, workload, channel=None, forecast=None, episodes=1, seed=0, n_att=10, wl0=0.5, max_items=None, log=None, resume=None, events=false))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run_session(
+    py: Python<'_>,
+    environment: &Bound<'_, PyAny>,
+    policy: &Bound<'_, PyAny>,
+    workload: &Bound<'_, PyAny>,
+    channel: Option<&Bound<'_, PyAny>>,
+    forecast: Option<&Bound<'_, PyAny>>,
+    episodes: usize,
+    seed: u64,
+    n_att: u32,
+    wl0: f64,
+    max_items: Option<usize>,
+    log: Option<PathBuf>,
+    resume: Option<PathBuf>,
+    events: bool,
+) -> PyResult<Py<PyAny>> {
+    let settings = SessionSettings::default()
+        .with_n_att(n_att)
+        .with_wl0(wl0)
+        .with_max_items(max_items);
+    settings.validate().py_err()?;
+    let (environment, _) = environment_arg(environment)?;
+    let mut exp = Experiment {
+        settings,
+        seed,
+        episodes,
+        environment,
+        policy: policy_arg(policy)?,
+        channel: channel_arg(channel)?,
+        workload: workload_arg(workload)?,
+        forecast: forecast.map(workload_arg).transpose()?,
+    };
+    drive(
+        py,
+        &mut exp,
+        CODE_SESSION,
+        PathBuf::from("<python>"),
+        PathBuf::from("."),
+        log,
+        resume,
+        events,
+    )
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(resume, m)?)?;
+    m.add_function(wrap_pyfunction!(run_session, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,169 @@
+//! The workload study from Python: the study CSV loader (what `hil
+//! workload summary/select/fit` read), cross-validated model selection and
+//! fitting, as hil-workload defines them.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use hil_workload::bundle::{StudySummary, bundled_study};
+use hil_workload::datasets::{Dataset, DatasetId};
+use hil_workload::models::{FittedModel, Provenance};
+use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_on_all};
+use hil_workload::study::Study;
+use pyo3::prelude::*;
+
+use crate::components::PyWorkloadHandle;
+use crate::convert::to_py;
+use crate::errors::IntoPy;
+
+/// A querying-workload study (NASA-TLX surveys after robot queries), read
+/// from the study CSV by `Study.load(path)` (errors name the file, line and
+/// column) or the bundled synthetic one, `Study.bundled()`.
+#[pyclass(module = "hil._hil", name = "Study", frozen)]
+pub(crate) struct PyStudy {
+    inner: Arc<Study>,
+}
+
+#[pymethods]
+impl PyStudy {
+    /// Loads and validates a study CSV.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let study = py.detach(|| Study::load(&path)).py_err()?;
+        Ok(Self {
+            inner: Arc::new(study),
+        })
+    }
+
+    /// hil's bundled synthetic study (calibrated to published figures).
+    #[staticmethod]
+    fn bundled(py: Python<'_>) -> PyResult<Self> {
+        let study = py.detach(bundled_study).py_err()?;
+        Ok(Self {
+            inner: Arc::new(study),
+        })
+    }
+
+    /// The file the study was read from.
+    #[getter]
+    fn source(&self) -> PathBuf {
+        self.inner.source().to_path_buf()
+    }
+
+    /// Every survey row as a dict (the serde form of `StudyRecord`).
+    fn records(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        to_py(py, self.inner.records(), "study records")
+    }
+
+    /// Headline figures per dataset (pairs, mean and sd of WL, mean WL_0)
+    /// and the D1 < D2 Mann-Whitney test, as `hil workload summary` prints.
+    fn summary(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let s = StudySummary::of(&self.inner).py_err()?;
+        to_py(py, &s, "study summary")
+    }
+
+    /// The study as CSV text (the format `load` reads).
+    fn to_csv(&self) -> String {
+        self.inner.to_csv()
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.records().len()
+    }
+}
+
+fn options(cv_seed: u64, threads: usize) -> SelectOptions {
+    SelectOptions {
+        seed: cv_seed,
+        threads,
+        ..SelectOptions::default()
+    }
+}
+
+/// Cross-validated model selection over D1, D2 and D12 (nested CV, the
+/// paper's candidates and histories), as `hil workload select`: the
+/// selection table as a dict (`rows`, each with the candidate, dataset and
+/// per-fold test MSEs and their median).
+#[pyfunction]
+#[pyo3(signature = (study, *, cv_seed=0, threads=0))]
+pub(crate) fn select_workload(
+    py: Python<'_>,
+    study: &Bound<'_, PyStudy>,
+    cv_seed: u64,
+    threads: usize,
+) -> PyResult<Py<PyAny>> {
+    let study = study.get().inner.clone();
+    let opts = options(cv_seed, threads);
+    let table = py
+        .detach(|| {
+            let sets: Vec<Dataset> = DatasetId::ALL
+                .iter()
+                .map(|&id| Dataset::build(&study, id))
+                .collect::<hil_core::Result<_>>()?;
+            let refs: Vec<&Dataset> = sets.iter().collect();
+            cross_validate(&refs, &Candidate::table(&opts.histories), &opts)
+        })
+        .py_err()?;
+    to_py(py, &table, "selection table")
+}
+
+/// Fits `model` (`granger`, `granger_sim`, `exp_impulse`, `average`,
+/// `constant`, ... as `hil workload fit --model`) with history `history`
+/// on `population` (`d1`, `d2` or `d12`) of `study`, the ridge penalty
+/// chosen by CV where the model has one. Writes the model JSON to `out` if
+/// given. Returns the fitted `WorkloadModel`.
+#[pyfunction]
+#[pyo3(signature = (study, *, population, model, history=None, name=None, cv_seed=0, threads=0, out=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fit_workload(
+    py: Python<'_>,
+    study: &Bound<'_, PyStudy>,
+    population: &str,
+    model: &str,
+    history: Option<usize>,
+    name: Option<String>,
+    cv_seed: u64,
+    threads: usize,
+    out: Option<PathBuf>,
+) -> PyResult<PyWorkloadHandle> {
+    let study = study.get().inner.clone();
+    let id = DatasetId::parse(population).py_err()?;
+    let cand = Candidate::parse(model, history).py_err()?;
+    let opts = options(cv_seed, threads);
+    let fitted = py
+        .detach(|| -> hil_core::Result<FittedModel> {
+            let d = Dataset::build(&study, id)?;
+            let (spec, lambda) = fit_on_all(&d, cand, &opts)?;
+            let name = name.unwrap_or_else(|| {
+                format!(
+                    "{model}_{}{}",
+                    id.as_str(),
+                    cand.history().map_or(String::new(), |h| format!("_h{h}"))
+                )
+            });
+            let m = FittedModel::new(
+                name,
+                spec,
+                Provenance {
+                    dataset: Some(id.as_str().into()),
+                    data: Some(study.source().display().to_string()),
+                    n_pairs: Some(d.pairs.len()),
+                    cv_test_mse: None,
+                    note: lambda.map(|l| format!("ridge λ = {l} chosen by 5-fold CV")),
+                },
+            );
+            if let Some(path) = &out {
+                m.save(path)?;
+            }
+            Ok(m)
+        })
+        .py_err()?;
+    Ok(PyWorkloadHandle::of(Arc::new(fitted)))
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyStudy>()?;
+    m.add_function(wrap_pyfunction!(select_workload, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_workload, m)?)?;
+    Ok(())
+}

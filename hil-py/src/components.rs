@@ -27,32 +27,32 @@ use crate::pycomponents::{PyChannel, PyEnvironment, PyPolicy, PyWorkload};
 
 /// A component table (`{"type": ..., **params}`) from a type name and
 /// keyword parameters.
-pub(crate) fn table(ty: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<Value> {
-    let mut v = match params {
-        Some(p) => from_py::<Value>(p.as_any(), "parameters")?,
-        None => Value::Object(Default::default()),
+pub(crate) fn table(ty: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<toml::Value> {
+    let mut t = match params {
+        Some(p) => match crate::convert::to_toml(p.as_any(), "parameters")? {
+            toml::Value::Table(t) => t,
+            _ => unreachable!("keyword arguments are a dict"),
+        },
+        None => toml::Table::new(),
     };
-    match v.as_object_mut() {
-        Some(o) => {
-            o.insert("type".into(), Value::String(ty.into()));
-        }
-        None => unreachable!("keyword arguments are a dict"),
-    }
-    Ok(v)
+    t.insert("type".into(), toml::Value::String(ty.into()));
+    Ok(toml::Value::Table(t))
 }
 
 /// Parses a component table as the config of one of the four kinds
 /// (built-in or registered type), then runs its `validate`.
 macro_rules! parse_config {
     ($fn:ident, $trait:ident) => {
-        pub(crate) fn $fn(v: Value) -> Result<Box<dyn $trait>> {
+        pub(crate) fn $fn(v: toml::Value) -> Result<Box<dyn $trait>> {
             let ty = v
                 .get("type")
-                .and_then(Value::as_str)
+                .and_then(toml::Value::as_str)
                 .unwrap_or("?")
                 .to_string();
             let cfg: Box<dyn $trait> = hil_core::plugin::component(v)
-                .map_err(|e| HilError::serde(format!("config of `{ty}`"), e))?;
+                .map_err(|e: toml::de::Error| {
+                    HilError::serde(format!("config of `{ty}`"), e.message().trim().to_string())
+                })?;
             cfg.validate()?;
             Ok(cfg)
         }

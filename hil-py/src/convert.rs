@@ -47,3 +47,49 @@ pub(crate) fn context(array: PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
 pub(crate) fn array<'py>(py: Python<'py>, context: &Context) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_slice(py, context.as_slice())
 }
+
+/// Plain Python data as a TOML value, the form component configs are
+/// read in (unlike JSON, TOML holds NaN and infinities, so a bad float
+/// reaches the parameter's own validation and its error names it).
+pub(crate) fn to_toml(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<toml::Value> {
+    use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+    if obj.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyInt>() {
+        return Ok(toml::Value::Integer(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(obj.extract()?));
+    }
+    if let Ok(s) = obj.cast::<PyString>() {
+        return Ok(toml::Value::String(s.to_cow()?.into_owned()));
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut t = toml::Table::new();
+        for (k, v) in d.iter() {
+            let key: String = k.extract()?;
+            let value = to_toml(&v, &format!("{what}.{key}"))?;
+            t.insert(key, value);
+        }
+        return Ok(toml::Value::Table(t));
+    }
+    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
+        let items = obj
+            .try_iter()?
+            .map(|v| to_toml(&v?, what))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(items));
+    }
+    // NumPy scalars and arrays: through their Python form.
+    if obj.hasattr("tolist")? {
+        return to_toml(&obj.call_method0("tolist")?, what);
+    }
+    Err(crate::errors::to_py_err(HilError::invalid_input(
+        what,
+        format!(
+            "a {} cannot be a config value (use bool, int, float, str, list or dict)",
+            obj.get_type().name()?
+        ),
+    )))
+}

@@ -83,17 +83,22 @@ fn options(cv_seed: u64, threads: usize) -> SelectOptions {
 /// Cross-validated model selection over D1, D2 and D12 (nested CV, the
 /// paper's candidates and histories), as `hil workload select`: the
 /// selection table as a dict (`rows`, each with the candidate, dataset and
-/// per-fold test MSEs and their median).
+/// per-fold test MSEs and their median). `histories` replaces the
+/// history lengths tried (default: the paper's 1, 5, ..., 30).
 #[pyfunction]
-#[pyo3(signature = (study, *, cv_seed=0, threads=0))]
+#[pyo3(signature = (study, *, cv_seed=0, threads=0, histories=None))]
 pub(crate) fn select_workload(
     py: Python<'_>,
     study: &Bound<'_, PyStudy>,
     cv_seed: u64,
     threads: usize,
+    histories: Option<Vec<usize>>,
 ) -> PyResult<Py<PyAny>> {
     let study = study.get().inner.clone();
-    let opts = options(cv_seed, threads);
+    let mut opts = options(cv_seed, threads);
+    if let Some(h) = histories {
+        opts.histories = h;
+    }
     let table = py
         .detach(|| {
             let sets: Vec<Dataset> = DatasetId::ALL

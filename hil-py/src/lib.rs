@@ -38,6 +38,10 @@ fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
     hil_workload::link();
     hil_envs::link();
     hil_channels::link();
+    #[cfg(feature = "kinova")]
+    hil_kinova_mujoco::link();
+    // Whether this build has the Kinova environment (`kinova_feeding`).
+    m.add("KINOVA", cfg!(feature = "kinova"))?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The UCB weight α of the paper's methods (hil's choice; the paper does not state it).
     m.add("PAPER_ALPHA", hil_experiments::method::PAPER_ALPHA)?;

@@ -14,6 +14,7 @@ from typing import Any, Optional
 
 from . import testing
 from ._hil import (
+    KINOVA,
     PAPER_ALPHA,
     ArmOutOfRangeError,
     BackendError,
@@ -46,6 +47,7 @@ from ._hil import (
 )
 
 __all__ = [
+    "KINOVA",
     "PAPER_ALPHA",
     "AlwaysQuery",
     "ArmOutOfRangeError",

@@ -8,9 +8,7 @@
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
 
-use hil_core::config::{
-    EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig,
-};
+use hil_core::config::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
 use hil_core::{
     ActionSpace, ArmId, BuildContext, Context, Decision, DecisionInput, Environment, Feedback,
     HilError, Item, LabelledObservation, Outcome, Policy, Query, QueryChannel, QueryHistory,
@@ -49,8 +47,8 @@ macro_rules! parse_config {
                 .and_then(toml::Value::as_str)
                 .unwrap_or("?")
                 .to_string();
-            let cfg: Box<dyn $trait> = hil_core::plugin::component(v)
-                .map_err(|e: toml::de::Error| {
+            let cfg: Box<dyn $trait> =
+                hil_core::plugin::component(v).map_err(|e: toml::de::Error| {
                     HilError::serde(format!("config of `{ty}`"), e.message().trim().to_string())
                 })?;
             cfg.validate()?;
@@ -246,7 +244,8 @@ impl PyPolicyHandle {
         let decision: Decision = py
             .detach(|| {
                 let forecast = WorkloadForecast::new(model.as_deref(), wl0, &history, t);
-                let input = DecisionInput::new(&x, t, forecast).at_item(item_index, items_seen, attempt);
+                let input =
+                    DecisionInput::new(&x, t, forecast).at_item(item_index, items_seen, attempt);
                 lock(&self.inner).decide(&input)
             })
             .py_err()?;
@@ -458,7 +457,9 @@ impl PyEnvironmentHandle {
     /// Executes `arm`; returns the `Outcome` as a dict (`success`,
     /// `success_probability`, ...).
     fn execute(&self, py: Python<'_>, arm: usize) -> PyResult<Py<PyAny>> {
-        let o: Outcome = py.detach(|| lock(&self.inner).execute(ArmId(arm))).py_err()?;
+        let o: Outcome = py
+            .detach(|| lock(&self.inner).execute(ArmId(arm)))
+            .py_err()?;
         to_py(py, &o, "outcome")
     }
 
@@ -518,12 +519,13 @@ impl Environment for SharedEnvironment {
     }
 }
 
+/// A built environment and its config, when it has one.
+pub(crate) type BuiltEnvironment = (Box<dyn Environment>, Option<Arc<dyn EnvironmentConfig>>);
+
 /// An environment argument: a `hil.Environment` (shared) or a Python
 /// object with the environment methods; with its config when it has one
 /// (for pretraining data).
-pub(crate) fn environment_arg(
-    obj: &Bound<'_, PyAny>,
-) -> PyResult<(Box<dyn Environment>, Option<Arc<dyn EnvironmentConfig>>)> {
+pub(crate) fn environment_arg(obj: &Bound<'_, PyAny>) -> PyResult<BuiltEnvironment> {
     if let Ok(h) = obj.cast::<PyEnvironmentHandle>() {
         let h = h.borrow();
         let env = SharedEnvironment {
@@ -535,7 +537,10 @@ pub(crate) fn environment_arg(
         };
         return Ok((Box::new(env), h.config.clone()));
     }
-    Ok((Box::new(PyEnvironment::new(obj.py(), obj.clone().unbind())?), None))
+    Ok((
+        Box::new(PyEnvironment::new(obj.py(), obj.clone().unbind())?),
+        None,
+    ))
 }
 
 // ---------------------------------------------------------- query channels

@@ -11,7 +11,11 @@ use serde::de::DeserializeOwned;
 use crate::errors::IntoPy;
 
 /// `value`'s serde form as plain Python data (dicts, lists, numbers, str).
-pub(crate) fn to_py<T: Serialize + ?Sized>(py: Python<'_>, value: &T, what: &str) -> PyResult<Py<PyAny>> {
+pub(crate) fn to_py<T: Serialize + ?Sized>(
+    py: Python<'_>,
+    value: &T,
+    what: &str,
+) -> PyResult<Py<PyAny>> {
     let text = serde_json::to_string(value)
         .map_err(|e| HilError::serde(what, e))
         .py_err()?;

@@ -109,7 +109,11 @@ create_exception!(
 fn class_and_fields<'py>(
     py: Python<'py>,
     error: &RustError,
-) -> PyResult<(Bound<'py, pyo3::types::PyType>, &'static str, Bound<'py, PyDict>)> {
+) -> PyResult<(
+    Bound<'py, pyo3::types::PyType>,
+    &'static str,
+    Bound<'py, PyDict>,
+)> {
     let d = PyDict::new(py);
     let (ty, kind) = match error {
         RustError::InvalidInput { what, why } => {
@@ -281,7 +285,10 @@ fn rebuild_hil_error(py: Python<'_>, err: &PyErr) -> Option<RustError> {
         return Some(RustError::state(string_of("component")?, string_of("why")?));
     }
     if err.is_instance_of::<InvalidInputError>(py) {
-        return Some(RustError::invalid_input(string_of("what")?, string_of("why")?));
+        return Some(RustError::invalid_input(
+            string_of("what")?,
+            string_of("why")?,
+        ));
     }
     None
 }

@@ -13,9 +13,9 @@
 //! (`hil-py/README.md`, "Python components inside hil", and `_hil.pyi`).
 
 use hil_core::{
-    ActionSpace, ArmId, CallOrder, Choice, Context, Decision, DecisionInput, Environment, Feedback, HilError,
-    Item, Outcome, Policy, Query, QueryChannel, QueryKind, Response, Result, WorkloadInput,
-    WorkloadModel,
+    ActionSpace, ArmId, CallOrder, Choice, Context, Decision, DecisionInput, Environment, Feedback,
+    HilError, Item, Outcome, Policy, Query, QueryChannel, QueryKind, Response, Result,
+    WorkloadInput, WorkloadModel,
 };
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -38,12 +38,7 @@ impl Held {
         let name = bound
             .getattr("name")
             .and_then(|n| n.extract::<String>())
-            .or_else(|_| {
-                bound
-                    .get_type()
-                    .name()
-                    .and_then(|n| n.extract::<String>())
-            })
+            .or_else(|_| bound.get_type().name().and_then(|n| n.extract::<String>()))
             .unwrap_or_else(|_| "?".into());
         Self {
             object,
@@ -53,12 +48,10 @@ impl Held {
 
     /// Runs `f` on the object with the GIL held; a Python exception
     /// becomes a hil error naming the component and `call`.
-    fn call<T>(
-        &self,
-        call: &str,
-        f: impl FnOnce(&Bound<'_, PyAny>) -> PyResult<T>,
-    ) -> Result<T> {
-        Python::attach(|py| f(self.object.bind(py)).map_err(|e| from_py_err(py, &self.label, call, e)))
+    fn call<T>(&self, call: &str, f: impl FnOnce(&Bound<'_, PyAny>) -> PyResult<T>) -> Result<T> {
+        Python::attach(|py| {
+            f(self.object.bind(py)).map_err(|e| from_py_err(py, &self.label, call, e))
+        })
     }
 
     fn has(&self, method: &str) -> bool {
@@ -173,7 +166,9 @@ impl Policy for PyPolicy {
         if self.held.has("seed") {
             // `seed` cannot fail in the trait; a failing Python `seed`
             // surfaces at the next call that can (it keeps its old seed).
-            let _ = self.held.call("seed", |o| o.call_method1("seed", (seed,)).map(drop));
+            let _ = self
+                .held
+                .call("seed", |o| o.call_method1("seed", (seed,)).map(drop));
         }
     }
 
@@ -207,8 +202,9 @@ impl Policy for PyPolicy {
                 "this policy cannot checkpoint its state",
             ));
         }
-        self.held
-            .call("save", |o| from_py(&o.call_method0("save")?, "a Python policy's state"))
+        self.held.call("save", |o| {
+            from_py(&o.call_method0("save")?, "a Python policy's state")
+        })
     }
 
     fn restore(&mut self, state: Value) -> Result<()> {
@@ -300,7 +296,9 @@ impl QueryChannel for PyChannel {
 
     fn seed(&mut self, seed: u64) {
         if self.held.has("seed") {
-            let _ = self.held.call("seed", |o| o.call_method1("seed", (seed,)).map(drop));
+            let _ = self
+                .held
+                .call("seed", |o| o.call_method1("seed", (seed,)).map(drop));
         }
     }
 
@@ -368,7 +366,8 @@ impl Environment for PyEnvironment {
         self.item = None;
         self.items = 0;
         self.order.on_reset();
-        self.held.call("reset", |o| o.call_method1("reset", (seed,)).map(drop))
+        self.held
+            .call("reset", |o| o.call_method1("reset", (seed,)).map(drop))
     }
 
     fn next_item(&mut self) -> Result<Option<Item>> {
@@ -420,7 +419,9 @@ impl Environment for PyEnvironment {
             return None;
         }
         self.held
-            .call("best_action", |o| o.call_method0("best_action")?.extract::<Option<usize>>())
+            .call("best_action", |o| {
+                o.call_method0("best_action")?.extract::<Option<usize>>()
+            })
             .ok()
             .flatten()
             .map(ArmId)

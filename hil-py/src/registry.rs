@@ -54,7 +54,7 @@ fn build<T>(
     Python::attach(|py| {
         let call = || -> PyResult<T> {
             let kwargs = PyDict::new(py);
-            if let Some(obj) = to_py(py, &params, "parameters")?.bind(py).cast::<PyDict>().ok() {
+            if let Ok(obj) = to_py(py, &params, "parameters")?.bind(py).cast::<PyDict>() {
                 kwargs.update(obj.as_mapping())?;
             }
             facts(&kwargs)?;
@@ -100,7 +100,9 @@ pub(crate) fn register_factory(kind: ComponentKind, name: &str, factory: Py<PyAn
             build(kind, &n, p, task_facts(ctx), |o| channel_arg(Some(o)))
         }),
         ComponentKind::Environment => r.environment(name, desc, move |p, ctx| {
-            build(kind, &n, p, base_facts(ctx), |o| environment_arg(o).map(|e| e.0))
+            build(kind, &n, p, base_facts(ctx), |o| {
+                environment_arg(o).map(|e| e.0)
+            })
         }),
         ComponentKind::WorkloadModel => r.workload_model(name, desc, move |p, ctx| {
             let m: Arc<dyn hil_core::WorkloadModel> =

@@ -59,15 +59,17 @@ fn add_methods(settings: &mut ProtocolSettings, extra: &Bound<'_, PyDict>) -> Py
         crate::registry::register_factory(ComponentKind::Policy, &type_name, factory.unbind())
             .py_err()?;
         let mut table = match params {
-            Some(p) => match crate::convert::to_toml(&p, &format!("parameters of method `{label}`"))? {
-                toml::Value::Table(t) => t,
-                _ => {
-                    return Err(to_py_err(HilError::invalid_input(
-                        format!("extra_methods.{label}"),
-                        "the parameters must be a dict",
-                    )));
+            Some(p) => {
+                match crate::convert::to_toml(&p, &format!("parameters of method `{label}`"))? {
+                    toml::Value::Table(t) => t,
+                    _ => {
+                        return Err(to_py_err(HilError::invalid_input(
+                            format!("extra_methods.{label}"),
+                            "the parameters must be a dict",
+                        )));
+                    }
                 }
-            },
+            }
             None => toml::Table::new(),
         };
         table.insert("type".into(), toml::Value::String(type_name));

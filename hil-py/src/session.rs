@@ -18,18 +18,36 @@ use crate::errors::IntoPy;
 
 /// The config text a component session's log header holds: its
 /// components were given in code, so a resume gives them again.
-const CODE_SESSION: &str = "# a session whose components were given in Python code (hil.run_session)\n";
+const CODE_SESSION: &str =
+    "# a session whose components were given in Python code (hil.run_session)\n";
 
-/// Runs `exp` (recording to `log` if given; continuing the session logged
-/// in `resume` if given) with the GIL released.
+/// Where a session's steps are recorded.
+enum Recording {
+    /// Nowhere.
+    Off,
+    /// In a new interaction log with this header.
+    To(PathBuf, Header),
+    /// Appended to this log, continuing the session it records.
+    Resume(PathBuf),
+}
+
+impl Recording {
+    /// Records to `log` (if given) under a header made by `header`, or
+    /// continues the session in `resume` (if given).
+    fn of(log: Option<PathBuf>, resume: Option<PathBuf>, header: impl FnOnce() -> Header) -> Self {
+        match (log, resume) {
+            (_, Some(path)) => Self::Resume(path),
+            (Some(path), None) => Self::To(path, header()),
+            (None, None) => Self::Off,
+        }
+    }
+}
+
+/// Runs `exp` as `recording` says, with the GIL released.
 fn drive(
     py: Python<'_>,
     exp: &mut Experiment,
-    header_text: &str,
-    config_path: PathBuf,
-    base: PathBuf,
-    log: Option<PathBuf>,
-    resume: Option<PathBuf>,
+    recording: Recording,
     events: bool,
 ) -> PyResult<Py<PyAny>> {
     let mut collector = EventCollector::default();
@@ -39,17 +57,16 @@ fn drive(
             if events {
                 observers.push(&mut collector);
             }
-            match (log, resume) {
-                (_, Some(path)) => {
+            match recording {
+                Recording::Resume(path) => {
                     let (log, logged) = RecordLog::open(&path)?;
                     run_recorded(exp, log, Some(&logged), &mut observers, |_, _| {})
                 }
-                (Some(path), None) => {
-                    let header = Header::new(header_text, config_path, base, exp.seed, exp.episodes);
+                Recording::To(path, header) => {
                     let log = RecordLog::create(&path, header)?;
                     run_recorded(exp, log, None, &mut observers, |_, _| {})
                 }
-                (None, None) => exp.run(&mut observers, |_, _| {}),
+                Recording::Off => exp.run(&mut observers, |_, _| {}),
             }
         })
         .py_err()?;
@@ -86,7 +103,11 @@ pub(crate) fn run(
         .parent()
         .map_or_else(|| config_abs.clone(), Path::to_path_buf);
     let mut exp = py.detach(|| cfg.build(&base)).py_err()?;
-    drive(py, &mut exp, &text, config_abs, base, log, None, events)
+    let (seed, episodes) = (exp.seed, exp.episodes);
+    let recording = Recording::of(log, None, || {
+        Header::new(&text, config_abs, base, seed, episodes)
+    });
+    drive(py, &mut exp, recording, events)
 }
 
 /// Continues the session recorded in `log` by `run(config, log=...)` (after
@@ -113,16 +134,7 @@ pub(crate) fn resume(py: Python<'_>, log: PathBuf, events: bool) -> PyResult<Py<
         .map_err(HilError::from)
         .py_err()?;
     let mut exp = py.detach(|| cfg.build(&header.base_dir)).py_err()?;
-    drive(
-        py,
-        &mut exp,
-        &header.config,
-        header.config_path.clone(),
-        header.base_dir.clone(),
-        None,
-        Some(log),
-        events,
-    )
+    drive(py, &mut exp, Recording::Resume(log), events)
 }
 
 /// Runs `episodes` episodes of hil's session loop over components given in
@@ -168,16 +180,10 @@ pub(crate) fn run_session(
         workload: workload_arg(workload)?,
         forecast: forecast.map(workload_arg).transpose()?,
     };
-    drive(
-        py,
-        &mut exp,
-        CODE_SESSION,
-        PathBuf::from("<python>"),
-        PathBuf::from("."),
-        log,
-        resume,
-        events,
-    )
+    let recording = Recording::of(log, resume, || {
+        Header::new(CODE_SESSION, "<python>", ".", seed, episodes)
+    });
+    drive(py, &mut exp, recording, events)
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -8,8 +8,8 @@
 //! channels, `factory(seed=...)` for environments and workload models.
 
 use hil_core::testing::{
-    CheckOptions, ConformanceFailure, ConformanceReport, check_environment_with,
-    check_policy_with, check_query_channel_with, check_workload_model_with,
+    CheckOptions, ConformanceFailure, ConformanceReport, check_environment_with, check_policy_with,
+    check_query_channel_with, check_workload_model_with,
 };
 use hil_core::{ActionSpace, Result};
 use pyo3::prelude::*;
@@ -25,7 +25,11 @@ fn report(py: Python<'_>, r: ConformanceReport) -> PyResult<Py<PyAny>> {
     d.set_item("subject", r.subject)?;
     let passed: Vec<&str> = r.passed.iter().map(|c| c.name()).collect();
     d.set_item("passed", passed)?;
-    let skipped: Vec<(&str, String)> = r.skipped.into_iter().map(|(c, why)| (c.name(), why)).collect();
+    let skipped: Vec<(&str, String)> = r
+        .skipped
+        .into_iter()
+        .map(|(c, why)| (c.name(), why))
+        .collect();
     d.set_item("skipped", skipped)?;
     Ok(d.into_any().unbind())
 }
@@ -43,7 +47,10 @@ fn failure(py: Python<'_>, f: ConformanceFailure) -> PyErr {
     err
 }
 
-fn finish(py: Python<'_>, r: std::result::Result<ConformanceReport, ConformanceFailure>) -> PyResult<Py<PyAny>> {
+fn finish(
+    py: Python<'_>,
+    r: std::result::Result<ConformanceReport, ConformanceFailure>,
+) -> PyResult<Py<PyAny>> {
     match r {
         Ok(r) => report(py, r),
         Err(f) => Err(failure(py, f)),
@@ -109,7 +116,11 @@ pub(crate) fn check_policy(
 /// most `attempts` attempts per item.
 #[pyfunction]
 #[pyo3(signature = (factory, *, attempts=3))]
-pub(crate) fn check_environment(py: Python<'_>, factory: Py<PyAny>, attempts: u32) -> PyResult<Py<PyAny>> {
+pub(crate) fn check_environment(
+    py: Python<'_>,
+    factory: Py<PyAny>,
+    attempts: u32,
+) -> PyResult<Py<PyAny>> {
     let opts = CheckOptions::default().with_attempts(attempts.max(1));
     let r = py.detach(|| {
         check_environment_with(

@@ -28,7 +28,8 @@ def test_the_quick_preset_runs_every_paper_method():
 
 
 def test_settings_from_a_dict_and_from_a_file_agree(tmp_path):
-    from_dict = hil.reproduce(dict(SMALL, seed=3), quick=True, records=True)
+    small = dict(SMALL, seed=3, methods=SMALL_METHODS, figures=FIGURES)
+    from_dict = hil.reproduce(small, quick=True, records=True)
     # The same settings written as a TOML file.
     settings = dict(from_dict["paper_protocol"]["settings"])
     path = tmp_path / "settings.toml"
@@ -50,7 +51,9 @@ def test_outputs_are_written_like_the_cli(tmp_path):
     assert (tmp_path / "results.json").exists() and (tmp_path / "tables.md").exists()
 
 
-SMALL_METHODS = [{"label": "LinUCB-QG", "policy": {"type": "linucb_qg", "alpha": 0.5, "pretrain": True, "w": 1.0}}]
+SMALL_METHODS = [
+    {"label": "LinUCB-QG", "policy": {"type": "linucb_qg", "alpha": 0.5, "pretrain": True, "w": 1.0}, "tune": {"w": [0.5, 4.0]}}
+]
 FIGURES = {"model": "f2_sim", "w_task": 0.7, "rollout": "LinUCB-QG", "workload": ["LinUCB-QG"]}
 
 

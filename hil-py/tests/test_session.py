@@ -137,3 +137,29 @@ def test_the_dataset_environment_from_python():
         lambda seed: hil.Environment("food_replay", foods=TEST_FOODS, seed=seed)
     )
     assert "replayable" in " ".join(report["passed"])
+
+
+def test_the_gil_is_released_while_a_session_runs():
+    import threading
+    import time
+
+    env = hil.Environment("food_replay", foods=TEST_FOODS, pretrain_foods=PRETRAIN_FOODS)
+    policy = hil.LinUCBQG(w=1.0, environment=env, pretrain=True)
+    ticks = []
+    stop = threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks.append(1)
+            time.sleep(0.001)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    time.sleep(0.05)
+    before = len(ticks)
+    hil.run_session(environment=env, policy=policy, workload="f2_sim", episodes=20, seed=2)
+    during = len(ticks) - before
+    stop.set()
+    t.join()
+    # Another Python thread kept running while hil's loop ran.
+    assert during > 5

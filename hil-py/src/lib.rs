@@ -40,8 +40,12 @@ fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
     hil_channels::link();
     #[cfg(feature = "kinova")]
     hil_kinova_mujoco::link();
-    // Whether this build has the Kinova environment (`kinova_feeding`).
-    m.add("KINOVA", cfg!(feature = "kinova"))?;
+    // Whether this build has the Kinova environment: whether its config
+    // type parses (nothing is built, MuJoCo is not called).
+    let mut probe = toml::Table::new();
+    probe.insert("type".into(), "kinova_feeding".into());
+    let kinova = components::environment_config(toml::Value::Table(probe)).is_ok();
+    m.add("KINOVA", kinova)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The UCB weight α of the paper's methods (hil's choice; the paper does not state it).
     m.add("PAPER_ALPHA", hil_experiments::method::PAPER_ALPHA)?;

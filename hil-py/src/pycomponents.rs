@@ -34,12 +34,7 @@ struct Held {
 
 impl Held {
     fn new(py: Python<'_>, object: Py<PyAny>, kind: &str) -> Self {
-        let bound = object.bind(py);
-        let name = bound
-            .getattr("name")
-            .and_then(|n| n.extract::<String>())
-            .or_else(|_| bound.get_type().name().and_then(|n| n.extract::<String>()))
-            .unwrap_or_else(|_| "?".into());
+        let name = name_of(object.bind(py));
         Self {
             object,
             label: format!("python {kind} `{name}`"),
@@ -60,8 +55,7 @@ impl Held {
 }
 
 /// The component's `name` attribute, or its class name.
-fn name_of(py: Python<'_>, object: &Bound<'_, PyAny>) -> String {
-    let _ = py;
+fn name_of(object: &Bound<'_, PyAny>) -> String {
     object
         .getattr("name")
         .and_then(|n| n.extract::<String>())
@@ -100,7 +94,7 @@ impl PyPolicy {
         let bound = held.object.bind(py);
         let n_arms = required_usize(bound, "n_arms", &held.label)?;
         let dim = required_usize(bound, "dim", &held.label)?;
-        let name = name_of(py, bound);
+        let name = name_of(bound);
         Ok(Self {
             held,
             name,
@@ -234,7 +228,7 @@ pub(crate) struct PyWorkload {
 impl PyWorkload {
     pub(crate) fn new(py: Python<'_>, object: Py<PyAny>) -> Self {
         let held = Held::new(py, object, "workload model");
-        let name = name_of(py, held.object.bind(py));
+        let name = name_of(held.object.bind(py));
         Self { held, name }
     }
 }
@@ -284,7 +278,7 @@ pub(crate) struct PyChannel {
 impl PyChannel {
     pub(crate) fn new(py: Python<'_>, object: Py<PyAny>) -> Self {
         let held = Held::new(py, object, "query channel");
-        let name = name_of(py, held.object.bind(py));
+        let name = name_of(held.object.bind(py));
         Self { held, name }
     }
 }
@@ -336,7 +330,7 @@ impl PyEnvironment {
         let names: Vec<String> = bound.getattr("actions")?.extract()?;
         let actions = ActionSpace::new(names).map_err(crate::errors::to_py_err)?;
         let dim = required_usize(bound, "context_dim", &held.label)?;
-        let name = name_of(py, bound);
+        let name = name_of(bound);
         Ok(Self {
             held,
             actions,

@@ -133,7 +133,9 @@ def LinUCB(
     ``options`` are further config keys (e.g. ``estimator={...}``).
     Bad values raise :class:`InvalidParameterError` naming the parameter.
     """
-    return _paper_policy("linucb", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options)
+    return _paper_policy(
+        "linucb", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options
+    )
 
 
 def AlwaysQuery(
@@ -152,7 +154,9 @@ def AlwaysQuery(
 
     Parameters as :func:`LinUCB`; ``query_kind=`` sets what it asks.
     """
-    return _paper_policy("always_query", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options)
+    return _paper_policy(
+        "always_query", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options
+    )
 
 
 def LinUCBExpDecay(
@@ -172,8 +176,9 @@ def LinUCBExpDecay(
 
     ``c`` (>= 0) sets the decay; other parameters as :func:`LinUCB`.
     """
+    options = dict(options, c=c)
     return _paper_policy(
-        "linucb_exp_decay", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, dict(options, c=c)
+        "linucb_exp_decay", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options
     )
 
 
@@ -197,6 +202,7 @@ def LinUCBQG(
     :meth:`Policy.decide` for the forecast. Other parameters as
     :func:`LinUCB`.
     """
+    options = dict(options, w=w)
     return _paper_policy(
-        "linucb_qg", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, dict(options, w=w)
+        "linucb_qg", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options
     )

@@ -292,10 +292,9 @@ impl PyPolicyHandle {
     }
 
     /// The diagnostics of a decision for `context` as a dict (per-arm
-    /// estimate, bonus and UCB; gap, threshold, query probability,
-    /// workload forecast where the policy computes them), without
-    /// changing what the policy will decide next... for deterministic
-    /// policies; a stochastic one draws from its RNG.
+    /// estimate, bonus and UCB; gap, threshold, query probability and
+    /// workload forecast where the policy computes them). It decides to
+    /// get them, so a stochastic policy's random stream advances.
     #[pyo3(signature = (context, t=1, *, workload=None, wl0=0.5, query_times=None))]
     fn diagnostics(
         &self,

@@ -252,8 +252,29 @@ pub(crate) fn from_py_err(py: Python<'_>, component: &str, call: &str, err: PyEr
     if let Some(e) = rebuild_hil_error(py, &err) {
         return e;
     }
-    let why = format!("{call} raised {err}");
+    let why = match raised_at(py, &err) {
+        Some(at) => format!("{call} raised {err} (at {at})"),
+        None => format!("{call} raised {err}"),
+    };
     RustError::backend(component, why).with_source(err)
+}
+
+/// `file:line in function` of the innermost frame of `err`'s traceback,
+/// so that a message read on the Rust side (a log, a protocol error) says
+/// where the Python code failed.
+fn raised_at(py: Python<'_>, err: &PyErr) -> Option<String> {
+    let mut tb = err.traceback(py)?.into_any();
+    while let Ok(next) = tb.getattr("tb_next") {
+        if next.is_none() {
+            break;
+        }
+        tb = next;
+    }
+    let line: usize = tb.getattr("tb_lineno").ok()?.extract().ok()?;
+    let code = tb.getattr("tb_frame").ok()?.getattr("f_code").ok()?;
+    let file: String = code.getattr("co_filename").ok()?.extract().ok()?;
+    let function: String = code.getattr("co_name").ok()?.extract().ok()?;
+    Some(format!("{file}:{line} in {function}"))
 }
 
 /// The Rust error of a hil exception that carries its attributes.

@@ -94,6 +94,7 @@ def test_a_python_exception_becomes_a_backend_error_naming_the_component():
     with pytest.raises(hil.BackendError) as e:
         hil.run_session(environment=env, policy=Exploding(env.actions, 2), workload=StepWorkload())
     assert "mean_py" in e.value.backend and "policy" in e.value.backend
+    assert "test_python_components.py" in e.value.why and "in decide" in e.value.why
     assert isinstance(e.value.__cause__, ZeroDivisionError)
     assert e.value.__cause__.__traceback__ is not None  # the Python traceback is kept
 

@@ -13,7 +13,7 @@ use crate::controller::{
 use crate::error::KinovaError;
 use crate::food::{FoodKind, FoodProps, Shape};
 use crate::model::{self, MjcfSource, N_TINES, SceneIds};
-use crate::skewer::{FoodView, SkewerModel, SkewerStats, TinePose, Wrench};
+use crate::skewer::{FoodView, MAX_DT, REF_DT, SkewerModel, SkewerStats, TinePose, Wrench};
 
 /// Height of the plate's top surface above its body frame (m).
 const PLATE_TOP: f64 = 0.006;
@@ -34,6 +34,13 @@ const MIN_INERTIA: f64 = 3e-6;
 const LEAF_RIB: f64 = 0.0035;
 /// Item height above the plate that counts as lifted (m).
 const LIFTED: f64 = 0.03;
+/// Step (s) of the phases in which no tine cuts: settling, the move to the
+/// pre-pose and the hold. Penetration and lift, where tines indent, pierce,
+/// cut and tear, run at the model's own step (at most [`REF_DT`]); a long
+/// step is also cut back to that whenever a tine is indenting.
+pub const FREE_DT: f64 = MAX_DT;
+/// Simulated time the items settle after staging (s).
+const SETTLE_TIME: f64 = 0.15;
 
 /// One item on the plate: kind, properties and pose relative to the plate centre.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -162,6 +169,7 @@ pub struct Simulator {
     leaf_under: Option<FoodKind>,
     target: Option<FoodKind>,
     dt: f64,
+    free_dt: f64,
     hold: f64,
     roll_by: RollBy,
     /// Contact bits of every geom as loaded, to restore parked bodies.
@@ -177,10 +185,19 @@ impl Simulator {
 
     /// Loads the scene from `source`.
     pub fn from_source(source: MjcfSource<'_>) -> Result<Self, KinovaError> {
+        let origin = source.origin();
         let (model, ids) = model::load(source)?;
         let kin_model = Box::new(model.clone());
         let model = Box::new(model);
         let dt = model.opt().timestep;
+        if !(dt > 0.0 && dt <= REF_DT + 1e-12) {
+            return Err(KinovaError::MjcfInvalid {
+                origin,
+                what: format!(
+                    "option timestep is {dt} s; the skewering model needs at most {REF_DT} s"
+                ),
+            });
+        }
         let mut kin = Kinematics::new(kin_model, ids.clone());
         let data = MjData::new(model);
         let plate_centre = Vector3::from(data.xpos()[ids.plate_body]);
@@ -215,6 +232,7 @@ impl Simulator {
             leaf_under: None,
             target: None,
             dt,
+            free_dt: FREE_DT,
             hold: PUBLISHED_HOLD,
             roll_by: RollBy::default(),
             contacts0,
@@ -230,6 +248,25 @@ impl Simulator {
         }
         self.hold = seconds;
         Ok(())
+    }
+
+    /// Sets the step of the phases in which no tine cuts (settling, the
+    /// move to the pre-pose, the hold); default [`FREE_DT`]. The model's own
+    /// step gives the slowest, most exact run.
+    pub fn set_free_step(&mut self, seconds: f64) -> Result<(), KinovaError> {
+        if !(seconds.is_finite() && seconds > 0.0 && seconds <= MAX_DT) {
+            return Err(KinovaError::InvalidFreeStep {
+                seconds,
+                max: MAX_DT,
+            });
+        }
+        self.free_dt = seconds;
+        Ok(())
+    }
+
+    /// The step of the phases in which no tine cuts (s).
+    pub fn free_step(&self) -> f64 {
+        self.free_dt
     }
 
     /// How long an item must stay on the lifted fork (s).
@@ -407,10 +444,8 @@ impl Simulator {
         self.target = Some(target);
         self.set_ctrl(&self.home.clone(), [0.0, 0.0]);
         self.data.forward();
-        let mut idle = SkewerModel::new(target.index(), self.dt);
-        for _ in 0..150 {
-            self.physics_step(&mut idle)?;
-        }
+        let mut idle = SkewerModel::new(target.index());
+        self.advance(&mut idle, SETTLE_TIME, self.free_dt)?;
         self.timing.total += start.elapsed();
         self.timing.cpu += thread_cpu_time().saturating_sub(cpu0);
         Ok(self.true_poses())
@@ -516,7 +551,42 @@ impl Simulator {
         Matrix3::from_row_slice(&self.data.site_xmat()[self.ids.wrist_site]) * f
     }
 
-    fn physics_step(&mut self, skewer: &mut SkewerModel) -> Result<(), KinovaError> {
+    /// Steps for `seconds` of simulated time with steps of at most `dt`.
+    fn advance(
+        &mut self,
+        skewer: &mut SkewerModel,
+        seconds: f64,
+        dt: f64,
+    ) -> Result<(), KinovaError> {
+        let mut t = 0.0;
+        while t < seconds - 1e-9 {
+            t += self.physics_step(skewer, dt.min(seconds - t))?;
+        }
+        Ok(())
+    }
+
+    /// One physics step of `dt` (cut back to the model's own step while a
+    /// tine is indenting: the indentation spring is only stable there);
+    /// returns the step taken.
+    fn physics_step(&mut self, skewer: &mut SkewerModel, dt: f64) -> Result<f64, KinovaError> {
+        let dt = if skewer.is_indenting() {
+            dt.min(self.dt)
+        } else {
+            dt.min(MAX_DT)
+        };
+        if self.data.model().opt().timestep != dt {
+            // SAFETY: only the step length changes; no count, address or
+            // array size of the model.
+            unsafe { self.data.model_mut().opt_mut().timestep = dt };
+        }
+        // mj_step1 computes the poses of this step; the skewering forces
+        // must come from them. (After a plain mj_step, xpos still holds the
+        // poses from before the integration: forces computed from them act
+        // one step late, and a delayed stiff spring rings - the coupling
+        // was unstable beyond 1 ms for that reason alone.)
+        let t0 = Instant::now();
+        self.data.step1();
+        let mut in_step = t0.elapsed();
         let d = &self.data;
         let sx = d.site_xpos();
         let sm = d.site_xmat();
@@ -538,7 +608,7 @@ impl Simulator {
         });
         let fork_com = Vector3::from(d.xipos()[self.ids.fork_body]);
         let mut on_food = [Wrench::default(); 3];
-        let on_fork = skewer.step(&tines, fork_com, &foods, &mut on_food);
+        let on_fork = skewer.step(dt, &tines, fork_com, &foods, &mut on_food);
         let xfrc = self.data.xfrc_applied_mut();
         for k in 0..3 {
             let w = &on_food[k];
@@ -546,10 +616,11 @@ impl Simulator {
         }
         xfrc[self.ids.fork_body] = wrench6(&on_fork);
         let t0 = Instant::now();
-        self.data.step();
-        self.timing.in_step += t0.elapsed();
+        self.data.step2();
+        in_step += t0.elapsed();
+        self.timing.in_step += in_step;
         self.timing.steps += 1;
-        Ok(())
+        Ok(dt)
     }
 
     /// Executes `action` on the staged target, as perceived.
@@ -568,7 +639,7 @@ impl Simulator {
             });
         };
         let t_begin = self.data.time();
-        let steps_before = self.step_count();
+        let steps_before = self.timing.steps;
         let beta = action.pitch;
         // With the fork's γ the arm holds the handle with the tine row (at
         // γ = 0) along the major axis and γ turns it by the action's roll;
@@ -586,7 +657,7 @@ impl Simulator {
         let q_pre = self
             .kin
             .solve(&self.home, fork, &PoseTarget { tip: pre, base }, "pre-pose")?;
-        let mut skewer = SkewerModel::new(target.index(), self.dt);
+        let mut skewer = SkewerModel::new(target.index());
         if let Some(k) = keyframe.as_mut() {
             k("start", &mut self.data);
         }
@@ -594,17 +665,15 @@ impl Simulator {
         // Pre-pose: joint-space minimum-jerk move; the fork motors turn to β.
         let home = self.home;
         let t_move = 0.6;
-        let n = (t_move / self.dt) as usize;
-        for i in 0..n {
-            let w = min_jerk(i as f64 / n as f64);
+        let mut t = 0.0;
+        while t < t_move - 1e-9 {
+            let w = min_jerk(t / t_move);
             let q: [f64; 6] = std::array::from_fn(|j| home[j] + w * (q_pre[j] - home[j]));
             self.set_ctrl(&q, fork);
-            self.physics_step(&mut skewer)?;
+            t += self.physics_step(&mut skewer, self.free_dt.min(t_move - t))?;
         }
         self.set_ctrl(&q_pre, fork);
-        for _ in 0..(0.15 / self.dt) as usize {
-            self.physics_step(&mut skewer)?;
-        }
+        self.advance(&mut skewer, 0.15, self.free_dt)?;
         self.check_finite("pre-pose")?;
         let reached_pitch = self.data.qpos()[self.ids.fork_qpos[0]];
         let reached_gamma = self.data.qpos()[self.ids.fork_qpos[1]];
@@ -634,7 +703,7 @@ impl Simulator {
             }
             step_i += 1;
             self.set_ctrl(&q, fork);
-            self.physics_step(&mut skewer)?;
+            self.physics_step(&mut skewer, self.dt)?;
             let f_ax = (self.wrist_force() - tare).dot(&u).abs();
             if travel > approach {
                 peak = peak.max(f_ax);
@@ -668,7 +737,7 @@ impl Simulator {
                 q = self.kin.dls_step(&q, fork, &target, 0.05).0;
             }
             self.set_ctrl(&q, fork);
-            self.physics_step(&mut skewer)?;
+            self.physics_step(&mut skewer, self.dt)?;
         }
         if let Some(k) = keyframe.as_mut() {
             k("lift", &mut self.data);
@@ -676,9 +745,7 @@ impl Simulator {
         let b = self.ids.food[target.index()].body;
         let lifted_height = self.data.xpos()[b][2] - self.plate_top_centre().z;
         let slip_at_lift = skewer.stats.slip_m;
-        for _ in 0..(self.hold / self.dt).round() as usize {
-            self.physics_step(&mut skewer)?;
-        }
+        self.advance(&mut skewer, self.hold, self.free_dt)?;
         self.check_finite("hold")?;
         if let Some(k) = keyframe.as_mut() {
             k("hold", &mut self.data);
@@ -703,12 +770,8 @@ impl Simulator {
             lifted_height,
             hold_slip: skewer.stats.slip_m - slip_at_lift,
             sim_time: self.data.time() - t_begin,
-            steps: self.step_count() - steps_before,
+            steps: self.timing.steps - steps_before,
         })
-    }
-
-    fn step_count(&self) -> u64 {
-        (self.data.time() / self.dt).round() as u64
     }
 
     /// Angle in [0, π/2] between the tine row (the roll link's y axis,

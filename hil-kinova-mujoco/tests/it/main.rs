@@ -3,3 +3,4 @@
 
 mod kinova;
 mod kinova_hold_roll;
+mod kinova_step;

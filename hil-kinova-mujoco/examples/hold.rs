@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut steps = 0u64;
     sim.set_hold(hold)?;
-    for kind in FoodKind::ALL {
+    for kind in FoodKind::SCENE {
         for a in &ACTIONS {
             let (mut lifted, mut held, mut slip, mut pierced) = (0, 0, 0.0, 0);
             for t in 0..trials {

@@ -154,13 +154,13 @@ fn resolve(model: &MjModel, origin: &str) -> Result<SceneIds, KinovaError> {
         qpos: 0,
         dof: 0,
     }; 3];
-    for kind in FoodKind::ALL {
+    for kind in FoodKind::SCENE {
         let want = match kind {
             FoodKind::Banana => MjtGeomBase::mjGEOM_CYLINDER,
             FoodKind::Carrot => MjtGeomBase::mjGEOM_CAPSULE,
-            FoodKind::Cantaloupe => MjtGeomBase::mjGEOM_BOX,
+            _ => MjtGeomBase::mjGEOM_BOX,
         };
-        food[kind.index()] = free_body(model, origin, &kind.body_name(), &kind.geom_name(), want)?;
+        food[kind.slot()] = free_body(model, origin, &kind.body_name(), &kind.geom_name(), want)?;
     }
     // The leaf is optional: a custom scene without one cannot stage the
     // `lettuce` setting, and says so when asked to.

@@ -328,16 +328,17 @@ impl Simulator {
         let cpu0 = thread_cpu_time();
         let mut props: [Option<FoodProps>; 3] = [None, None, None];
         for p in items {
-            if props[p.props.kind.index()].is_some() {
+            if props[p.props.kind.slot()].is_some() {
                 return Err(KinovaError::MjcfInvalid {
                     origin: "scene".into(),
                     what: format!(
-                        "the scene has one body per food kind; {} appears twice",
-                        p.props.kind.name()
+                        "the scene has one body per calibrated kind; {} takes the {} body twice",
+                        p.props.kind.name(),
+                        p.props.kind.base().name()
                     ),
                 });
             }
-            props[p.props.kind.index()] = Some(p.props.clone());
+            props[p.props.kind.slot()] = Some(p.props.clone());
         }
         let leaf_ids = match (leaf, self.ids.lettuce) {
             (Some(l), None) => {
@@ -354,30 +355,30 @@ impl Simulator {
             (_, ids) => ids,
         };
         if let Some(l) = leaf
-            && props[l.under.index()].is_none()
+            && props[l.under.slot()].is_none()
         {
             return Err(KinovaError::MjcfInvalid {
                 origin: "scene".into(),
                 what: format!("the {} on the lettuce is not on the plate", l.under.name()),
             });
         }
-        if props[target.index()].is_none() {
+        if props[target.slot()].is_none() {
             return Err(KinovaError::MjcfInvalid {
                 origin: "scene".into(),
                 what: format!("target {} is not on the plate", target.name()),
             });
         }
-        for kind in FoodKind::ALL {
-            if let Some(p) = &props[kind.index()] {
+        for kind in FoodKind::SCENE {
+            if let Some(p) = &props[kind.slot()] {
                 self.apply_props(kind, p);
             }
         }
         // Items not on the plate, and the leaf when nothing lies on it, are
         // parked: no contacts and weightless, so they cost the solver
         // nothing (resting on the floor they made half of all contacts).
-        for kind in FoodKind::ALL {
-            let body = self.ids.food[kind.index()].body;
-            self.set_parked(body, props[kind.index()].is_none());
+        for kind in FoodKind::SCENE {
+            let body = self.ids.food[kind.slot()].body;
+            self.set_parked(body, props[kind.slot()].is_none());
         }
         if let Some(l) = leaf_ids {
             self.set_parked(l.body, leaf.is_none());
@@ -401,13 +402,15 @@ impl Simulator {
             for i in 0..6 {
                 qpos[ids.arm_qpos[i]] = home[i];
             }
-            for kind in FoodKind::ALL {
-                let f = ids.food[kind.index()];
-                let (pos, yaw) = match items.iter().find(|p| p.props.kind == kind) {
+            for kind in FoodKind::SCENE {
+                let f = ids.food[kind.slot()];
+                let (pos, yaw) = match items.iter().find(|p| p.props.kind.slot() == kind.slot()) {
                     Some(p) => {
                         let h = p.props.shape.half_extents()[2];
                         let (xy, base) = match leaf {
-                            Some(l) if l.under == kind => (l.xy, leaf_thickness + LEAF_RIB),
+                            Some(l) if l.under.slot() == kind.slot() => {
+                                (l.xy, leaf_thickness + LEAF_RIB)
+                            }
                             _ => (p.xy, 0.0),
                         };
                         (
@@ -417,7 +420,7 @@ impl Simulator {
                         )
                     }
                     None => (
-                        Vector3::new(-0.6, -0.3 + 0.3 * kind.index() as f64, 0.05),
+                        Vector3::new(-0.6, -0.3 + 0.3 * kind.slot() as f64, 0.05),
                         0.0,
                     ),
                 };
@@ -444,7 +447,7 @@ impl Simulator {
         self.target = Some(target);
         self.set_ctrl(&self.home.clone(), [0.0, 0.0]);
         self.data.forward();
-        let mut idle = SkewerModel::new(target.index());
+        let mut idle = SkewerModel::new(target.slot());
         self.advance(&mut idle, SETTLE_TIME, self.free_dt)?;
         self.timing.total += start.elapsed();
         self.timing.cpu += thread_cpu_time().saturating_sub(cpu0);
@@ -478,7 +481,7 @@ impl Simulator {
     }
 
     fn apply_props(&mut self, kind: FoodKind, p: &FoodProps) {
-        let f = self.ids.food[kind.index()];
+        let f = self.ids.food[kind.slot()];
         let (size, aabb) = match p.shape {
             Shape::Disc {
                 radius,
@@ -520,18 +523,18 @@ impl Simulator {
 
     /// True poses of the items on the plate.
     pub fn true_poses(&self) -> Vec<TruePose> {
-        FoodKind::ALL
+        FoodKind::SCENE
             .into_iter()
             .filter_map(|kind| {
-                let p = self.props[kind.index()].as_ref()?;
-                let b = self.ids.food[kind.index()].body;
+                let p = self.props[kind.slot()].as_ref()?;
+                let b = self.ids.food[kind.slot()].body;
                 let r = Matrix3::from_row_slice(&self.data.xmat()[b]);
                 Some(TruePose {
-                    kind,
+                    kind: p.kind,
                     centre: self.data.xpos()[b],
                     yaw: r[(1, 0)].atan2(r[(0, 0)]),
                     half_extents: p.shape.half_extents(),
-                    on_leaf: self.leaf_under == Some(kind),
+                    on_leaf: self.leaf_under.map(FoodKind::slot) == Some(kind.slot()),
                 })
             })
             .collect()
@@ -657,7 +660,7 @@ impl Simulator {
         let q_pre = self
             .kin
             .solve(&self.home, fork, &PoseTarget { tip: pre, base }, "pre-pose")?;
-        let mut skewer = SkewerModel::new(target.index());
+        let mut skewer = SkewerModel::new(target.slot());
         if let Some(k) = keyframe.as_mut() {
             k("start", &mut self.data);
         }
@@ -742,7 +745,7 @@ impl Simulator {
         if let Some(k) = keyframe.as_mut() {
             k("lift", &mut self.data);
         }
-        let b = self.ids.food[target.index()].body;
+        let b = self.ids.food[target.slot()].body;
         let lifted_height = self.data.xpos()[b][2] - self.plate_top_centre().z;
         let slip_at_lift = skewer.stats.slip_m;
         self.advance(&mut skewer, self.hold, self.free_dt)?;
@@ -751,7 +754,7 @@ impl Simulator {
             k("hold", &mut self.data);
         }
         let height = self.data.xpos()[b][2] - self.plate_top_centre().z;
-        let success = height > LIFTED && skewer.pierced_into(target.index()) >= 1;
+        let success = height > LIFTED && skewer.pierced_into(target.slot()) >= 1;
         self.timing.total += start.elapsed();
         self.timing.cpu += thread_cpu_time().saturating_sub(cpu0);
         self.timing.attempts += 1;

@@ -251,8 +251,8 @@ pub fn parse_label<T: Label>(s: &str) -> Option<T> {
 ///
 /// let foods: Vec<FoodKind> = parse_labels("plate", &["carrot".into()])?;
 /// assert_eq!(foods, [FoodKind::Carrot]);
-/// let err = parse_labels::<FoodKind>("plate", &["kiwi".into()]).unwrap_err();
-/// assert!(err.to_string().contains("kiwi"));
+/// let err = parse_labels::<FoodKind>("plate", &["apple".into()]).unwrap_err();
+/// assert!(err.to_string().contains("apple"));
 /// # Ok::<(), hil_core::HilError>(())
 /// ```
 pub fn parse_labels<T: Label>(field: &str, values: &[String]) -> hil_core::Result<Vec<T>> {

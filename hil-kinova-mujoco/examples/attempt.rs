@@ -10,7 +10,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut sim = Simulator::new()?;
     println!("home {:?}", sim.home());
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-    for kind in FoodKind::ALL {
+    for kind in FoodKind::SCENE {
         for a in &ACTIONS {
             let props = FoodModel::default_for(kind).sample(&mut rng);
             let items = vec![Placement {

@@ -3,7 +3,7 @@
 //! the fork after the lift, how many after the hold, and the mean slip
 //! along the tines during the hold.
 //!
-//! `cargo run --release -p hil-kinova-mujoco --example hold -- [trials] [hold_s]`
+//! `cargo run --release -p hil-kinova-mujoco --example hold -- [trials] [hold_s] [free_step_s]`
 use hil_kinova_mujoco::ACTIONS;
 use hil_kinova_mujoco::food::{FoodKind, FoodModel};
 use hil_kinova_mujoco::sim::{PerceivedTarget, Placement, Simulator};
@@ -14,9 +14,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let trials: usize = args.get(1).map_or(Ok(8), |s| s.parse())?;
     let hold: f64 = args.get(2).map_or(Ok(5.0), |s| s.parse())?;
     let mut sim = Simulator::new()?;
+    if let Some(dt) = args.get(3) {
+        sim.set_free_step(dt.parse()?)?;
+    }
     let mut steps = 0u64;
     sim.set_hold(hold)?;
-    for kind in FoodKind::ALL {
+    for kind in FoodKind::SCENE {
         for a in &ACTIONS {
             let (mut lifted, mut held, mut slip, mut pierced) = (0, 0, 0.0, 0);
             for t in 0..trials {

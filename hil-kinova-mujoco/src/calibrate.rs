@@ -62,7 +62,7 @@ pub struct CalibrationOptions {
 impl Default for CalibrationOptions {
     fn default() -> Self {
         Self {
-            foods: FoodKind::ALL.to_vec(),
+            foods: FoodKind::SCENE.to_vec(),
             settings: Setting::ALL.to_vec(),
             trials: 30,
             seed: 1,

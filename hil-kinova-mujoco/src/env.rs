@@ -63,10 +63,15 @@ pub struct KinovaFeedingConfig {
     pub noise: PerceptionNoise,
     /// Simulated attempts per (food, action) offered to policies as
     /// pretraining data (`pretrain = true` in their configs); 0 offers none.
-    /// They are drawn from the plate's own foods on a separate seed stream
-    /// (the paper pretrained on other foods, which this scene lacks).
+    /// They run on a separate seed stream, on `pretrain_foods`.
     #[serde(default)]
     pub pretraining_trials: usize,
+    /// The foods of the pretraining attempts, each alone on the plate in
+    /// one of `settings`. Empty (the default): the plate's own foods. The
+    /// paper pretrained on foods not on the plate: name derived kinds
+    /// (`honeydew`, `kiwi`, `celery`; see [`FoodKind`]).
+    #[serde(default)]
+    pub pretrain_foods: Vec<String>,
     /// How long an item must stay on the lifted fork to count (s); the
     /// published rule is 5 s.
     #[serde(default = "default_hold")]
@@ -82,7 +87,10 @@ fn default_hold() -> f64 {
 }
 
 fn default_plate() -> Vec<String> {
-    FoodKind::ALL.iter().map(|k| k.name().to_string()).collect()
+    FoodKind::SCENE
+        .iter()
+        .map(|k| k.name().to_string())
+        .collect()
 }
 fn default_settings() -> Vec<String> {
     Setting::ALL.iter().map(|k| k.name().to_string()).collect()
@@ -105,6 +113,7 @@ impl Default for KinovaFeedingConfig {
             mjcf: None,
             noise: PerceptionNoise::default(),
             pretraining_trials: 0,
+            pretrain_foods: Vec::new(),
             hold_s: PUBLISHED_HOLD,
             roll_by: RollBy::default(),
         }
@@ -116,12 +125,22 @@ impl KinovaFeedingConfig {
         parse_labels("plate", &self.plate)
     }
 
+    /// The foods of the pretraining attempts (the plate's when none are named).
+    fn pretraining_foods(&self) -> Result<Vec<FoodKind>> {
+        if self.pretrain_foods.is_empty() {
+            self.foods()
+        } else {
+            parse_labels("pretrain_foods", &self.pretrain_foods)
+        }
+    }
+
     fn parsed_settings(&self) -> Result<Vec<Setting>> {
         parse_labels("settings", &self.settings)
     }
 
     fn validate(&self) -> Result<()> {
         self.foods()?;
+        self.pretraining_foods()?;
         self.parsed_settings()?;
         if self.context_dim == 0 || self.context_dim > 4096 {
             return Err(HilError::invalid_parameter(
@@ -173,6 +192,11 @@ impl EnvironmentConfig for KinovaFeedingConfig {
         check_count("context_dim", self.context_dim, MAX_CONTEXT_DIM)?;
         check_at_most("settings", self.settings.len(), ITEMS_PER_EPISODE)?;
         check_at_most(
+            "pretrain_foods",
+            self.pretrain_foods.len(),
+            ITEMS_PER_EPISODE,
+        )?;
+        check_at_most(
             "pretraining_trials",
             self.pretraining_trials,
             MAX_PRETRAINING_TRIALS,
@@ -198,12 +222,13 @@ impl EnvironmentConfig for KinovaFeedingConfig {
 const PRETRAIN_STREAM: u64 = 0x7072_6574_7261_696e;
 
 /// Runs `cfg.pretraining_trials` attempts of every action on every distinct
-/// food of the plate and returns them as labelled observations.
+/// food of `cfg.pretrain_foods` (default: the plate's) and returns them as
+/// labelled observations.
 pub fn simulated_pretraining(
     cfg: &KinovaFeedingConfig,
     seed: u64,
 ) -> Result<Vec<LabelledObservation>> {
-    let mut foods = cfg.foods()?;
+    let mut foods = cfg.pretraining_foods()?;
     foods.sort();
     foods.dedup();
     let mut out = Vec::new();
@@ -399,7 +424,9 @@ impl KinovaFeedingEnv {
         let mut placed = vec![first];
         if self.cfg.neighbours {
             for &k in &self.foods[self.cursor..] {
-                if placed.iter().any(|p| p.props.kind == k) {
+                // One body per calibrated kind: a neighbour sharing the
+                // target's body (honeydew beside cantaloupe) stays off.
+                if placed.iter().any(|p| p.props.kind.slot() == k.slot()) {
                     continue;
                 }
                 let props = self.models[k.index()].sample(rng);

@@ -64,6 +64,14 @@ pub enum KinovaError {
         /// The value given.
         seconds: f64,
     },
+    /// The step of the phases without cutting is not in (0, `MAX_DT`].
+    #[error("free-phase step {seconds} s is not in (0, {max}] s")]
+    InvalidFreeStep {
+        /// The value given.
+        seconds: f64,
+        /// The longest step the skewering model tolerates.
+        max: f64,
+    },
 }
 
 impl From<KinovaError> for HilError {

@@ -16,7 +16,17 @@ use serde::{Deserialize, Serialize};
 
 use hil_envs::feeding::{FeedingTask, FoodFacts};
 
-/// A kind of food the scene holds (one MuJoCo body each).
+/// A kind of food. The scene holds one MuJoCo body for each of the three
+/// calibrated kinds ([`FoodKind::SCENE`]: the plate of the paper's study);
+/// the others are **derived** kinds, used to pretrain policies on foods
+/// that are not on the plate, as the paper did. A derived kind is one of
+/// the 16 published foods and takes from the feeding data its name,
+/// description, published rates and expert answer, and its own colour; its
+/// shape and mechanics are those of its base kind ([`FoodKind::base`]),
+/// unchanged, and it is staged in its base kind's body. Its simulated
+/// success rates are therefore its base kind's, **not calibrated** to the
+/// published rates of the food it is named after (`hil kinova calibrate
+/// --foods honeydew,kiwi,celery` shows both).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
 #[serde(rename_all = "snake_case")]
 pub enum FoodKind {
@@ -26,11 +36,48 @@ pub enum FoodKind {
     Carrot,
     /// A cantaloupe cube: medium, juicy.
     Cantaloupe,
+    /// A honeydew cube, derived from cantaloupe (not calibrated).
+    Honeydew,
+    /// A kiwi slice, derived from banana (not calibrated).
+    Kiwi,
+    /// A celery piece, derived from carrot (not calibrated).
+    Celery,
 }
 
 impl FoodKind {
-    /// Every kind, in scene order.
-    pub const ALL: [FoodKind; 3] = [FoodKind::Banana, FoodKind::Carrot, FoodKind::Cantaloupe];
+    /// The calibrated kinds, one scene body each, in scene order.
+    pub const SCENE: [FoodKind; 3] = [FoodKind::Banana, FoodKind::Carrot, FoodKind::Cantaloupe];
+
+    /// Every kind: the calibrated ones, then the derived ones.
+    pub const ALL: [FoodKind; 6] = [
+        FoodKind::Banana,
+        FoodKind::Carrot,
+        FoodKind::Cantaloupe,
+        FoodKind::Honeydew,
+        FoodKind::Kiwi,
+        FoodKind::Celery,
+    ];
+
+    /// The calibrated kind whose shape, mechanics and scene body this kind
+    /// uses (itself for a calibrated kind).
+    pub fn base(self) -> FoodKind {
+        match self {
+            FoodKind::Honeydew => FoodKind::Cantaloupe,
+            FoodKind::Kiwi => FoodKind::Banana,
+            FoodKind::Celery => FoodKind::Carrot,
+            k => k,
+        }
+    }
+
+    /// Whether this kind is derived from another (not calibrated).
+    pub fn is_derived(self) -> bool {
+        self.base() != self
+    }
+
+    /// Index of this kind's scene body in [`FoodKind::SCENE`].
+    pub fn slot(self) -> usize {
+        self.base() as usize
+    }
 
     /// The label used in items, configs and tables.
     pub fn name(self) -> &'static str {
@@ -38,27 +85,30 @@ impl FoodKind {
             FoodKind::Banana => "banana",
             FoodKind::Carrot => "carrot",
             FoodKind::Cantaloupe => "cantaloupe",
+            FoodKind::Honeydew => "honeydew",
+            FoodKind::Kiwi => "kiwi",
+            FoodKind::Celery => "celery",
         }
     }
 
-    /// Parses a label (`banana`, `carrot`, `cantaloupe`).
+    /// Parses a label (`banana`, `carrot`, `cantaloupe`, `honeydew`, `kiwi`, `celery`).
     pub fn parse(s: &str) -> Option<Self> {
         parse_label(s)
     }
 
-    /// Index in [`FoodKind::ALL`].
+    /// Index in [`FoodKind::ALL`] (a scene body's index is [`slot`](Self::slot)).
     pub fn index(self) -> usize {
         self as usize
     }
 
-    /// Name of the item's body in the MJCF.
+    /// Name of the item's body in the MJCF (its base kind's).
     pub fn body_name(self) -> String {
-        format!("food_{}", self.name())
+        format!("food_{}", self.base().name())
     }
 
-    /// Name of the item's geom in the MJCF.
+    /// Name of the item's geom in the MJCF (its base kind's).
     pub fn geom_name(self) -> String {
-        format!("food_{}_geom", self.name())
+        format!("food_{}_geom", self.base().name())
     }
 
     /// The published facts of this food (rates, description), from the
@@ -108,6 +158,9 @@ impl FoodKind {
             FoodKind::Banana => [0.96, 0.92, 0.62],
             FoodKind::Carrot => [0.95, 0.50, 0.12],
             FoodKind::Cantaloupe => [0.98, 0.66, 0.38],
+            FoodKind::Honeydew => [0.80, 0.90, 0.60],
+            FoodKind::Kiwi => [0.55, 0.74, 0.22],
+            FoodKind::Celery => [0.62, 0.82, 0.45],
         }
     }
 }
@@ -198,8 +251,8 @@ pub fn parse_label<T: Label>(s: &str) -> Option<T> {
 ///
 /// let foods: Vec<FoodKind> = parse_labels("plate", &["carrot".into()])?;
 /// assert_eq!(foods, [FoodKind::Carrot]);
-/// let err = parse_labels::<FoodKind>("plate", &["kiwi".into()]).unwrap_err();
-/// assert!(err.to_string().contains("kiwi"));
+/// let err = parse_labels::<FoodKind>("plate", &["apple".into()]).unwrap_err();
+/// assert!(err.to_string().contains("apple"));
 /// # Ok::<(), hil_core::HilError>(())
 /// ```
 pub fn parse_labels<T: Label>(field: &str, values: &[String]) -> hil_core::Result<Vec<T>> {
@@ -437,6 +490,13 @@ pub struct FoodModel {
 impl FoodModel {
     /// The built-in (calibrated) model of `kind`.
     pub fn default_for(kind: FoodKind) -> Self {
+        if kind.is_derived() {
+            // The base kind's distributions, unchanged (see FoodKind).
+            return FoodModel {
+                kind,
+                ..Self::default_for(kind.base())
+            };
+        }
         match kind {
             FoodKind::Banana => FoodModel {
                 kind,
@@ -477,6 +537,9 @@ impl FoodModel {
                 tear_per_m: (200.0, 0.3),
                 cut_fraction_of_width: 0.4,
             },
+            FoodKind::Honeydew | FoodKind::Kiwi | FoodKind::Celery => {
+                unreachable!("derived kinds return above")
+            }
         }
     }
 
@@ -493,7 +556,7 @@ impl FoodModel {
             .iter()
             .map(|&m| pos(m, self.dims_rel_sd))
             .collect();
-        let shape = match self.kind {
+        let shape = match self.kind.base() {
             FoodKind::Banana => Shape::Disc {
                 radius: d[0],
                 half_height: d[1],
@@ -510,6 +573,7 @@ impl FoodModel {
                 }
                 Shape::Cuboid { half: h }
             }
+            derived => unreachable!("{derived:?} is not a base kind"),
         };
         let puncture_force = pos(self.puncture_force.0, self.puncture_force.1);
         FoodProps {
@@ -550,7 +614,8 @@ mod tests {
         assert_eq!(FoodKind::Carrot.expert_action(), 1);
         assert_eq!(FoodKind::Cantaloupe.expert_action(), 1);
         assert_eq!(FoodKind::parse("carrot"), Some(FoodKind::Carrot));
-        assert_eq!(FoodKind::parse("kiwi"), None);
+        assert_eq!(FoodKind::parse("apple"), None);
+        assert_eq!(FoodKind::parse("kiwi"), Some(FoodKind::Kiwi));
     }
 
     #[test]

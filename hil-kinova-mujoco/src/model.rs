@@ -28,7 +28,7 @@ pub enum MjcfSource<'a> {
 }
 
 impl MjcfSource<'_> {
-    fn origin(&self) -> String {
+    pub(crate) fn origin(&self) -> String {
         match self {
             MjcfSource::Builtin => "<built-in gen3_feeding.xml>".into(),
             MjcfSource::File(p) => p.display().to_string(),
@@ -83,6 +83,7 @@ pub struct FoodIds {
 
 /// Loads the scene from `source` and resolves its names.
 pub fn load(source: MjcfSource<'_>) -> Result<(MjModel, SceneIds), KinovaError> {
+    keep_logs_out_of_cwd();
     let origin = source.origin();
     let model = match source {
         MjcfSource::Builtin => MjModel::from_xml_string(BUILTIN_MJCF),
@@ -153,13 +154,13 @@ fn resolve(model: &MjModel, origin: &str) -> Result<SceneIds, KinovaError> {
         qpos: 0,
         dof: 0,
     }; 3];
-    for kind in FoodKind::ALL {
+    for kind in FoodKind::SCENE {
         let want = match kind {
             FoodKind::Banana => MjtGeomBase::mjGEOM_CYLINDER,
             FoodKind::Carrot => MjtGeomBase::mjGEOM_CAPSULE,
-            FoodKind::Cantaloupe => MjtGeomBase::mjGEOM_BOX,
+            _ => MjtGeomBase::mjGEOM_BOX,
         };
-        food[kind.index()] = free_body(model, origin, &kind.body_name(), &kind.geom_name(), want)?;
+        food[kind.slot()] = free_body(model, origin, &kind.body_name(), &kind.geom_name(), want)?;
     }
     // The leaf is optional: a custom scene without one cannot stage the
     // `lettuce` setting, and says so when asked to.
@@ -218,4 +219,20 @@ fn free_body(
         qpos: model.jnt_qposadr()[joint] as usize,
         dof: model.jnt_dofadr()[joint] as usize,
     })
+}
+
+/// Stops MuJoCo's default log handler from appending its warnings to
+/// `MUJOCO_LOG.TXT` in the working directory (it did so for every unstable
+/// trial a test provoked). Warnings still go to stderr, and the simulator
+/// reads the data warnings it acts on (`mjWARN_BADQACC`) from `mjData`
+/// and turns them into [`KinovaError::Diverged`].
+fn keep_logs_out_of_cwd() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        use mujoco_rs::wrappers::mj_logging::{log_config, set_log_config};
+        // SAFETY: every simulator, and so every MuJoCo call of this crate,
+        // starts with `load`, which passes through this `Once`: a thread
+        // that races here blocks until the configuration is written.
+        unsafe { set_log_config(log_config().with_logto_file(false)) };
+    });
 }

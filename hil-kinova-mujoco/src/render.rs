@@ -40,6 +40,13 @@ impl KeyframeRecorder {
         self.attempt = 0;
     }
 
+    /// Keeps only the pending frames whose name passes `keep` (names are
+    /// `{prefix}_{attempt}_{item}_{phase}`, phases `start`, `pre_pose`,
+    /// `skewer`, `lift`, `hold`).
+    pub fn retain(&mut self, mut keep: impl FnMut(&str) -> bool) {
+        self.frames.retain(|f| keep(&f.name));
+    }
+
     /// Frames recorded and not yet written.
     pub fn pending(&self) -> usize {
         self.frames.len()
@@ -64,7 +71,30 @@ impl KeyframeRecorder {
     }
 }
 
-/// Writes recorded keyframes as 640×480 PNGs from the scene's `side` camera.
+/// Which camera renders the keyframes, and at what size.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct View {
+    /// Name of a camera in the MJCF.
+    pub camera: String,
+    /// Image width (pixels).
+    pub width: u32,
+    /// Image height (pixels).
+    pub height: u32,
+}
+
+impl Default for View {
+    /// The whole arm and plate: the `side` camera at 640×480.
+    fn default() -> Self {
+        Self {
+            camera: "side".into(),
+            width: 640,
+            height: 480,
+        }
+    }
+}
+
+/// Writes recorded keyframes as PNGs (by default 640×480 from the scene's
+/// `side` camera; see [`View`]).
 #[derive(Debug)]
 pub struct KeyframeWriter {
     dir: PathBuf,
@@ -81,24 +111,35 @@ impl KeyframeWriter {
     /// Opens an offscreen renderer for `sim`'s model, writing into `dir`
     /// (created if missing). Errors say why rendering is unavailable.
     pub fn new(dir: &Path, sim: &Simulator) -> std::result::Result<Self, String> {
+        Self::with_view(dir, sim, &View::default())
+    }
+
+    /// As [`new`](Self::new), rendering through `view`.
+    pub fn with_view(
+        dir: &Path,
+        sim: &Simulator,
+        view: &View,
+    ) -> std::result::Result<Self, String> {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-        Self::open(dir, sim)
+        Self::open(dir, sim, view)
     }
 
     #[cfg(feature = "render")]
-    fn open(dir: &Path, sim: &Simulator) -> std::result::Result<Self, String> {
+    fn open(dir: &Path, sim: &Simulator, view: &View) -> std::result::Result<Self, String> {
         use mujoco_rs::renderer::MjRenderer;
         let model = sim.data().model();
         let cam = model
-            .name_to_id(MjtObjBase::mjOBJ_CAMERA, "side")
-            .ok_or("the scene has no camera named `side`")?;
+            .name_to_id(MjtObjBase::mjOBJ_CAMERA, &view.camera)
+            .ok_or_else(|| format!("the scene has no camera named `{}`", view.camera))?;
         let renderer = MjRenderer::builder()
-            .width(640)
-            .height(480)
+            .width(view.width)
+            .height(view.height)
             .rgb(true)
             .depth(false)
             .camera(MjvCamera::new_fixed(cam))
+            // Committed pictures stay small (the default writes raw pixels).
+            .png_compression(mujoco_rs::renderer::png::Compression::High)
             .build(model)
             .map_err(|e| format!("no offscreen EGL context: {e}"))?;
         Ok(Self {
@@ -111,7 +152,7 @@ impl KeyframeWriter {
     }
 
     #[cfg(not(feature = "render"))]
-    fn open(_dir: &Path, _sim: &Simulator) -> std::result::Result<Self, String> {
+    fn open(_dir: &Path, _sim: &Simulator, _view: &View) -> std::result::Result<Self, String> {
         Err("hil-kinova-mujoco was built without the `render` feature".into())
     }
 

@@ -13,7 +13,7 @@ use crate::controller::{
 use crate::error::KinovaError;
 use crate::food::{FoodKind, FoodProps, Shape};
 use crate::model::{self, MjcfSource, N_TINES, SceneIds};
-use crate::skewer::{FoodView, SkewerModel, SkewerStats, TinePose, Wrench};
+use crate::skewer::{FoodView, MAX_DT, REF_DT, SkewerModel, SkewerStats, TinePose, Wrench};
 
 /// Height of the plate's top surface above its body frame (m).
 const PLATE_TOP: f64 = 0.006;
@@ -34,6 +34,13 @@ const MIN_INERTIA: f64 = 3e-6;
 const LEAF_RIB: f64 = 0.0035;
 /// Item height above the plate that counts as lifted (m).
 const LIFTED: f64 = 0.03;
+/// Step (s) of the phases in which no tine cuts: settling, the move to the
+/// pre-pose and the hold. Penetration and lift, where tines indent, pierce,
+/// cut and tear, run at the model's own step (at most [`REF_DT`]); a long
+/// step is also cut back to that whenever a tine is indenting.
+pub const FREE_DT: f64 = MAX_DT;
+/// Simulated time the items settle after staging (s).
+const SETTLE_TIME: f64 = 0.15;
 
 /// One item on the plate: kind, properties and pose relative to the plate centre.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -162,6 +169,7 @@ pub struct Simulator {
     leaf_under: Option<FoodKind>,
     target: Option<FoodKind>,
     dt: f64,
+    free_dt: f64,
     hold: f64,
     roll_by: RollBy,
     /// Contact bits of every geom as loaded, to restore parked bodies.
@@ -177,10 +185,19 @@ impl Simulator {
 
     /// Loads the scene from `source`.
     pub fn from_source(source: MjcfSource<'_>) -> Result<Self, KinovaError> {
+        let origin = source.origin();
         let (model, ids) = model::load(source)?;
         let kin_model = Box::new(model.clone());
         let model = Box::new(model);
         let dt = model.opt().timestep;
+        if !(dt > 0.0 && dt <= REF_DT + 1e-12) {
+            return Err(KinovaError::MjcfInvalid {
+                origin,
+                what: format!(
+                    "option timestep is {dt} s; the skewering model needs at most {REF_DT} s"
+                ),
+            });
+        }
         let mut kin = Kinematics::new(kin_model, ids.clone());
         let data = MjData::new(model);
         let plate_centre = Vector3::from(data.xpos()[ids.plate_body]);
@@ -215,6 +232,7 @@ impl Simulator {
             leaf_under: None,
             target: None,
             dt,
+            free_dt: FREE_DT,
             hold: PUBLISHED_HOLD,
             roll_by: RollBy::default(),
             contacts0,
@@ -230,6 +248,25 @@ impl Simulator {
         }
         self.hold = seconds;
         Ok(())
+    }
+
+    /// Sets the step of the phases in which no tine cuts (settling, the
+    /// move to the pre-pose, the hold); default [`FREE_DT`]. The model's own
+    /// step gives the slowest, most exact run.
+    pub fn set_free_step(&mut self, seconds: f64) -> Result<(), KinovaError> {
+        if !(seconds.is_finite() && seconds > 0.0 && seconds <= MAX_DT) {
+            return Err(KinovaError::InvalidFreeStep {
+                seconds,
+                max: MAX_DT,
+            });
+        }
+        self.free_dt = seconds;
+        Ok(())
+    }
+
+    /// The step of the phases in which no tine cuts (s).
+    pub fn free_step(&self) -> f64 {
+        self.free_dt
     }
 
     /// How long an item must stay on the lifted fork (s).
@@ -291,16 +328,17 @@ impl Simulator {
         let cpu0 = thread_cpu_time();
         let mut props: [Option<FoodProps>; 3] = [None, None, None];
         for p in items {
-            if props[p.props.kind.index()].is_some() {
+            if props[p.props.kind.slot()].is_some() {
                 return Err(KinovaError::MjcfInvalid {
                     origin: "scene".into(),
                     what: format!(
-                        "the scene has one body per food kind; {} appears twice",
-                        p.props.kind.name()
+                        "the scene has one body per calibrated kind; {} takes the {} body twice",
+                        p.props.kind.name(),
+                        p.props.kind.base().name()
                     ),
                 });
             }
-            props[p.props.kind.index()] = Some(p.props.clone());
+            props[p.props.kind.slot()] = Some(p.props.clone());
         }
         let leaf_ids = match (leaf, self.ids.lettuce) {
             (Some(l), None) => {
@@ -317,30 +355,30 @@ impl Simulator {
             (_, ids) => ids,
         };
         if let Some(l) = leaf
-            && props[l.under.index()].is_none()
+            && props[l.under.slot()].is_none()
         {
             return Err(KinovaError::MjcfInvalid {
                 origin: "scene".into(),
                 what: format!("the {} on the lettuce is not on the plate", l.under.name()),
             });
         }
-        if props[target.index()].is_none() {
+        if props[target.slot()].is_none() {
             return Err(KinovaError::MjcfInvalid {
                 origin: "scene".into(),
                 what: format!("target {} is not on the plate", target.name()),
             });
         }
-        for kind in FoodKind::ALL {
-            if let Some(p) = &props[kind.index()] {
+        for kind in FoodKind::SCENE {
+            if let Some(p) = &props[kind.slot()] {
                 self.apply_props(kind, p);
             }
         }
         // Items not on the plate, and the leaf when nothing lies on it, are
         // parked: no contacts and weightless, so they cost the solver
         // nothing (resting on the floor they made half of all contacts).
-        for kind in FoodKind::ALL {
-            let body = self.ids.food[kind.index()].body;
-            self.set_parked(body, props[kind.index()].is_none());
+        for kind in FoodKind::SCENE {
+            let body = self.ids.food[kind.slot()].body;
+            self.set_parked(body, props[kind.slot()].is_none());
         }
         if let Some(l) = leaf_ids {
             self.set_parked(l.body, leaf.is_none());
@@ -364,13 +402,15 @@ impl Simulator {
             for i in 0..6 {
                 qpos[ids.arm_qpos[i]] = home[i];
             }
-            for kind in FoodKind::ALL {
-                let f = ids.food[kind.index()];
-                let (pos, yaw) = match items.iter().find(|p| p.props.kind == kind) {
+            for kind in FoodKind::SCENE {
+                let f = ids.food[kind.slot()];
+                let (pos, yaw) = match items.iter().find(|p| p.props.kind.slot() == kind.slot()) {
                     Some(p) => {
                         let h = p.props.shape.half_extents()[2];
                         let (xy, base) = match leaf {
-                            Some(l) if l.under == kind => (l.xy, leaf_thickness + LEAF_RIB),
+                            Some(l) if l.under.slot() == kind.slot() => {
+                                (l.xy, leaf_thickness + LEAF_RIB)
+                            }
                             _ => (p.xy, 0.0),
                         };
                         (
@@ -380,7 +420,7 @@ impl Simulator {
                         )
                     }
                     None => (
-                        Vector3::new(-0.6, -0.3 + 0.3 * kind.index() as f64, 0.05),
+                        Vector3::new(-0.6, -0.3 + 0.3 * kind.slot() as f64, 0.05),
                         0.0,
                     ),
                 };
@@ -407,10 +447,8 @@ impl Simulator {
         self.target = Some(target);
         self.set_ctrl(&self.home.clone(), [0.0, 0.0]);
         self.data.forward();
-        let mut idle = SkewerModel::new(target.index(), self.dt);
-        for _ in 0..150 {
-            self.physics_step(&mut idle)?;
-        }
+        let mut idle = SkewerModel::new(target.slot());
+        self.advance(&mut idle, SETTLE_TIME, self.free_dt)?;
         self.timing.total += start.elapsed();
         self.timing.cpu += thread_cpu_time().saturating_sub(cpu0);
         Ok(self.true_poses())
@@ -443,7 +481,7 @@ impl Simulator {
     }
 
     fn apply_props(&mut self, kind: FoodKind, p: &FoodProps) {
-        let f = self.ids.food[kind.index()];
+        let f = self.ids.food[kind.slot()];
         let (size, aabb) = match p.shape {
             Shape::Disc {
                 radius,
@@ -485,18 +523,18 @@ impl Simulator {
 
     /// True poses of the items on the plate.
     pub fn true_poses(&self) -> Vec<TruePose> {
-        FoodKind::ALL
+        FoodKind::SCENE
             .into_iter()
             .filter_map(|kind| {
-                let p = self.props[kind.index()].as_ref()?;
-                let b = self.ids.food[kind.index()].body;
+                let p = self.props[kind.slot()].as_ref()?;
+                let b = self.ids.food[kind.slot()].body;
                 let r = Matrix3::from_row_slice(&self.data.xmat()[b]);
                 Some(TruePose {
-                    kind,
+                    kind: p.kind,
                     centre: self.data.xpos()[b],
                     yaw: r[(1, 0)].atan2(r[(0, 0)]),
                     half_extents: p.shape.half_extents(),
-                    on_leaf: self.leaf_under == Some(kind),
+                    on_leaf: self.leaf_under.map(FoodKind::slot) == Some(kind.slot()),
                 })
             })
             .collect()
@@ -516,7 +554,42 @@ impl Simulator {
         Matrix3::from_row_slice(&self.data.site_xmat()[self.ids.wrist_site]) * f
     }
 
-    fn physics_step(&mut self, skewer: &mut SkewerModel) -> Result<(), KinovaError> {
+    /// Steps for `seconds` of simulated time with steps of at most `dt`.
+    fn advance(
+        &mut self,
+        skewer: &mut SkewerModel,
+        seconds: f64,
+        dt: f64,
+    ) -> Result<(), KinovaError> {
+        let mut t = 0.0;
+        while t < seconds - 1e-9 {
+            t += self.physics_step(skewer, dt.min(seconds - t))?;
+        }
+        Ok(())
+    }
+
+    /// One physics step of `dt` (cut back to the model's own step while a
+    /// tine is indenting: the indentation spring is only stable there);
+    /// returns the step taken.
+    fn physics_step(&mut self, skewer: &mut SkewerModel, dt: f64) -> Result<f64, KinovaError> {
+        let dt = if skewer.is_indenting() {
+            dt.min(self.dt)
+        } else {
+            dt.min(MAX_DT)
+        };
+        if self.data.model().opt().timestep != dt {
+            // SAFETY: only the step length changes; no count, address or
+            // array size of the model.
+            unsafe { self.data.model_mut().opt_mut().timestep = dt };
+        }
+        // mj_step1 computes the poses of this step; the skewering forces
+        // must come from them. (After a plain mj_step, xpos still holds the
+        // poses from before the integration: forces computed from them act
+        // one step late, and a delayed stiff spring rings - the coupling
+        // was unstable beyond 1 ms for that reason alone.)
+        let t0 = Instant::now();
+        self.data.step1();
+        let mut in_step = t0.elapsed();
         let d = &self.data;
         let sx = d.site_xpos();
         let sm = d.site_xmat();
@@ -538,7 +611,7 @@ impl Simulator {
         });
         let fork_com = Vector3::from(d.xipos()[self.ids.fork_body]);
         let mut on_food = [Wrench::default(); 3];
-        let on_fork = skewer.step(&tines, fork_com, &foods, &mut on_food);
+        let on_fork = skewer.step(dt, &tines, fork_com, &foods, &mut on_food);
         let xfrc = self.data.xfrc_applied_mut();
         for k in 0..3 {
             let w = &on_food[k];
@@ -546,10 +619,11 @@ impl Simulator {
         }
         xfrc[self.ids.fork_body] = wrench6(&on_fork);
         let t0 = Instant::now();
-        self.data.step();
-        self.timing.in_step += t0.elapsed();
+        self.data.step2();
+        in_step += t0.elapsed();
+        self.timing.in_step += in_step;
         self.timing.steps += 1;
-        Ok(())
+        Ok(dt)
     }
 
     /// Executes `action` on the staged target, as perceived.
@@ -568,7 +642,7 @@ impl Simulator {
             });
         };
         let t_begin = self.data.time();
-        let steps_before = self.step_count();
+        let steps_before = self.timing.steps;
         let beta = action.pitch;
         // With the fork's γ the arm holds the handle with the tine row (at
         // γ = 0) along the major axis and γ turns it by the action's roll;
@@ -586,7 +660,7 @@ impl Simulator {
         let q_pre = self
             .kin
             .solve(&self.home, fork, &PoseTarget { tip: pre, base }, "pre-pose")?;
-        let mut skewer = SkewerModel::new(target.index(), self.dt);
+        let mut skewer = SkewerModel::new(target.slot());
         if let Some(k) = keyframe.as_mut() {
             k("start", &mut self.data);
         }
@@ -594,17 +668,15 @@ impl Simulator {
         // Pre-pose: joint-space minimum-jerk move; the fork motors turn to β.
         let home = self.home;
         let t_move = 0.6;
-        let n = (t_move / self.dt) as usize;
-        for i in 0..n {
-            let w = min_jerk(i as f64 / n as f64);
+        let mut t = 0.0;
+        while t < t_move - 1e-9 {
+            let w = min_jerk(t / t_move);
             let q: [f64; 6] = std::array::from_fn(|j| home[j] + w * (q_pre[j] - home[j]));
             self.set_ctrl(&q, fork);
-            self.physics_step(&mut skewer)?;
+            t += self.physics_step(&mut skewer, self.free_dt.min(t_move - t))?;
         }
         self.set_ctrl(&q_pre, fork);
-        for _ in 0..(0.15 / self.dt) as usize {
-            self.physics_step(&mut skewer)?;
-        }
+        self.advance(&mut skewer, 0.15, self.free_dt)?;
         self.check_finite("pre-pose")?;
         let reached_pitch = self.data.qpos()[self.ids.fork_qpos[0]];
         let reached_gamma = self.data.qpos()[self.ids.fork_qpos[1]];
@@ -634,7 +706,7 @@ impl Simulator {
             }
             step_i += 1;
             self.set_ctrl(&q, fork);
-            self.physics_step(&mut skewer)?;
+            self.physics_step(&mut skewer, self.dt)?;
             let f_ax = (self.wrist_force() - tare).dot(&u).abs();
             if travel > approach {
                 peak = peak.max(f_ax);
@@ -668,23 +740,21 @@ impl Simulator {
                 q = self.kin.dls_step(&q, fork, &target, 0.05).0;
             }
             self.set_ctrl(&q, fork);
-            self.physics_step(&mut skewer)?;
+            self.physics_step(&mut skewer, self.dt)?;
         }
         if let Some(k) = keyframe.as_mut() {
             k("lift", &mut self.data);
         }
-        let b = self.ids.food[target.index()].body;
+        let b = self.ids.food[target.slot()].body;
         let lifted_height = self.data.xpos()[b][2] - self.plate_top_centre().z;
         let slip_at_lift = skewer.stats.slip_m;
-        for _ in 0..(self.hold / self.dt).round() as usize {
-            self.physics_step(&mut skewer)?;
-        }
+        self.advance(&mut skewer, self.hold, self.free_dt)?;
         self.check_finite("hold")?;
         if let Some(k) = keyframe.as_mut() {
             k("hold", &mut self.data);
         }
         let height = self.data.xpos()[b][2] - self.plate_top_centre().z;
-        let success = height > LIFTED && skewer.pierced_into(target.index()) >= 1;
+        let success = height > LIFTED && skewer.pierced_into(target.slot()) >= 1;
         self.timing.total += start.elapsed();
         self.timing.cpu += thread_cpu_time().saturating_sub(cpu0);
         self.timing.attempts += 1;
@@ -703,12 +773,8 @@ impl Simulator {
             lifted_height,
             hold_slip: skewer.stats.slip_m - slip_at_lift,
             sim_time: self.data.time() - t_begin,
-            steps: self.step_count() - steps_before,
+            steps: self.timing.steps - steps_before,
         })
-    }
-
-    fn step_count(&self) -> u64 {
-        (self.data.time() / self.dt).round() as u64
     }
 
     /// Angle in [0, π/2] between the tine row (the roll link's y axis,

@@ -30,9 +30,13 @@
 //! and their rotational inertia tiny, and explicit torques from stiff
 //! springs would destabilise them; tine-side forces act at the tines.
 //!
-//! Spring constants are limited by the item's mass and the time step so the
-//! explicit coupling stays stable (`k·dt²/m` small); physical puncture forces
-//! are kept, only the indentation depth at which they are reached grows.
+//! Spring constants are limited by the item's mass and the reference time
+//! step [`REF_DT`] so the explicit coupling stays stable (`k·dt²/m` small);
+//! physical puncture forces are kept, only the indentation depth at which
+//! they are reached grows. The constants are fixed physical values (set
+//! once from `REF_DT`), so a caller may step the model with a longer `dt`
+//! where no piercing happens (the hold): `k·dt²/m` then grows by
+//! `(dt/REF_DT)²` and stays stable up to [`MAX_DT`].
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -41,6 +45,15 @@ use crate::model::N_TINES;
 
 /// Tine length from tip to root (m), from the fork mesh (fact sheet §2).
 pub const TINE_LENGTH: f64 = 0.030;
+/// The step (s) the coupling constants are expressed against: the
+/// model's base timestep.
+pub const REF_DT: f64 = 0.001;
+/// The longest step (s) the explicit coupling tolerates: with four tines
+/// pierced, `4·COUPLING_STIFFNESS·(dt/REF_DT)²` and
+/// `4·COUPLING_DAMPING·dt/REF_DT` must stay inside the stability region of
+/// semi-implicit Euler (`a + 2b < 4` for `a = k·dt²/m`, `b = c·dt/m`); at
+/// 4 ms `a + 2b = 1.92 + 1.6`, and the margin shrinks fast beyond.
+pub const MAX_DT: f64 = 0.004;
 const EMBED_SAMPLES: usize = 20;
 
 /// The state of one tine.
@@ -139,24 +152,33 @@ pub struct SkewerModel {
     /// Counters.
     pub stats: SkewerStats,
     target: usize,
+    /// Length of the current step (s).
     dt: f64,
 }
 
 impl SkewerModel {
-    /// A fresh model for an attempt at item `target`, stepping every `dt` s.
-    pub fn new(target: usize, dt: f64) -> Self {
+    /// A fresh model for an attempt at item `target`.
+    pub fn new(target: usize) -> Self {
         Self {
             tines: [TineState::Free; N_TINES],
             touched: [false; N_TINES],
             stats: SkewerStats::default(),
             target,
-            dt,
+            dt: REF_DT,
         }
     }
 
     /// The tines' states.
     pub fn tines(&self) -> &[TineState; N_TINES] {
         &self.tines
+    }
+
+    /// Some tine is pressing on a surface before puncture: the stiff
+    /// indentation spring needs the short reference step.
+    pub fn is_indenting(&self) -> bool {
+        self.tines
+            .iter()
+            .any(|t| matches!(t, TineState::Indenting { .. }))
     }
 
     /// Number of tines currently pierced into item `food`.
@@ -167,15 +189,19 @@ impl SkewerModel {
             .count()
     }
 
-    /// Advances the model one step: returns the wrench on each item and the
-    /// wrench on the fork body (centre of mass `fork_com`).
+    /// Advances the model one step of `dt` s (at most [`MAX_DT`]): returns
+    /// the wrench on each item and the wrench on the fork body (centre of
+    /// mass `fork_com`).
     pub fn step(
         &mut self,
+        dt: f64,
         tines: &[TinePose; N_TINES],
         fork_com: Vector3<f64>,
         foods: &[FoodView<'_>],
         out_food: &mut [Wrench],
     ) -> Wrench {
+        debug_assert!(dt > 0.0 && dt <= MAX_DT + 1e-12, "step {dt} s");
+        self.dt = dt;
         let mut fork = Wrench::default();
         for w in out_food.iter_mut() {
             *w = Wrench::default();
@@ -252,9 +278,7 @@ impl SkewerModel {
                 if d < -0.0005 {
                     return TineState::Free;
                 }
-                let k = props
-                    .indent_stiffness
-                    .min(stable_stiffness(props.mass, self.dt));
+                let k = props.indent_stiffness.min(stable_stiffness(props.mass));
                 let normal = k * d.max(0.0);
                 if normal >= props.puncture_force {
                     // Anchor the item point that now lies on the tine line,
@@ -273,7 +297,7 @@ impl SkewerModel {
                 }
                 // Lateral: the tip drags the surface point by friction.
                 let lat = rel - d * u;
-                let k_lat = COUPLING_STIFFNESS * props.mass / (self.dt * self.dt);
+                let k_lat = coupling_stiffness(props.mass);
                 let mut f_lat = k_lat * lat;
                 let cap = 0.5 * normal;
                 if f_lat.norm() > cap {
@@ -302,8 +326,8 @@ impl SkewerModel {
                 };
                 let pt = tp.tip - s * u;
                 let mut delta = f.pos + f.rot * anchor - pt;
-                let k = COUPLING_STIFFNESS * props.mass / (self.dt * self.dt);
-                let c = COUPLING_DAMPING * props.mass / self.dt;
+                let k = coupling_stiffness(props.mass);
+                let c = coupling_damping(props.mass);
                 let embedded = embedded_length(tp, f, props);
                 // Lateral: the flesh bears at most `yield_lat`; beyond it the
                 // tine cuts sideways (the anchor moves with it). A slot longer
@@ -409,15 +433,25 @@ const GLANCE_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
 /// Largest downward force passed to an item pressed against the plate (N).
 const PRESS_CAP: f64 = 1.0;
-/// Per-tine coupling stiffness of a pierced tine, in units of m/dt².
+/// Per-tine coupling stiffness of a pierced tine, in units of m/REF_DT².
 const COUPLING_STIFFNESS: f64 = 0.03;
-/// Per-tine coupling damping of a pierced tine, in units of m/dt.
+/// Per-tine coupling damping of a pierced tine, in units of m/REF_DT.
 const COUPLING_DAMPING: f64 = 0.05;
 
-/// The largest per-tine stiffness the explicit coupling of an item of mass
-/// `m` tolerates at step `dt` with four tines engaged.
-fn stable_stiffness(m: f64, dt: f64) -> f64 {
-    0.1 * m / (dt * dt)
+/// Per-tine coupling stiffness (N/m) for an item of mass `m`.
+fn coupling_stiffness(m: f64) -> f64 {
+    COUPLING_STIFFNESS * m / (REF_DT * REF_DT)
+}
+
+/// Per-tine coupling damping (N·s/m) for an item of mass `m`.
+fn coupling_damping(m: f64) -> f64 {
+    COUPLING_DAMPING * m / REF_DT
+}
+
+/// The largest per-tine indentation stiffness the explicit coupling of an
+/// item of mass `m` tolerates at [`REF_DT`] with four tines engaged.
+fn stable_stiffness(m: f64) -> f64 {
+    0.1 * m / (REF_DT * REF_DT)
 }
 
 /// Length of the tine (tip back to root) inside the item.
@@ -444,7 +478,7 @@ mod tests {
     }
 
     fn press(props: &FoodProps, depth: f64) -> (SkewerModel, Wrench) {
-        let mut m = SkewerModel::new(0, 0.001);
+        let mut m = SkewerModel::new(0);
         let top = props.shape.half_extents()[2];
         let foods = [FoodView {
             pos: Vector3::zeros(),
@@ -462,7 +496,13 @@ mod tests {
                 tip: Vector3::new(0.0, y, z),
                 dir: -Vector3::z(),
             });
-            fork = m.step(&tines, Vector3::new(0.0, 0.0, 0.1), &foods, &mut out);
+            fork = m.step(
+                REF_DT,
+                &tines,
+                Vector3::new(0.0, 0.0, 0.1),
+                &foods,
+                &mut out,
+            );
         }
         (m, fork)
     }
@@ -482,12 +522,18 @@ mod tests {
         // the flank 0.85 r off the axis (about 58° from the normal).
         let mut state = |y: f64| {
             let z = (r * r - y * y).sqrt() - 0.0002;
-            let mut m = SkewerModel::new(0, 0.001);
+            let mut m = SkewerModel::new(0);
             let t = TinePose {
                 tip: Vector3::new(0.0, y, z),
                 dir: -Vector3::z(),
             };
-            m.step(&[t; N_TINES], Vector3::new(0.0, 0.0, 0.1), &foods, &mut out);
+            m.step(
+                REF_DT,
+                &[t; N_TINES],
+                Vector3::new(0.0, 0.0, 0.1),
+                &foods,
+                &mut out,
+            );
             m.tines()[0]
         };
         assert!(matches!(state(0.0), TineState::Indenting { .. }));

@@ -18,7 +18,7 @@ use hil_core::{HilError, Result};
 use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyResult};
 use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
 use hil_kinova_mujoco::controller::RollBy;
-use hil_kinova_mujoco::food::{Label, parse_labels};
+use hil_kinova_mujoco::food::{FoodKind, Label, parse_labels};
 use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
 use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
 
@@ -46,7 +46,8 @@ pub struct CalibrateArgs {
     /// Master seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Foods to run (default: all).
+    /// Foods to run (default: the three calibrated ones, banana, carrot,
+    /// cantaloupe; the derived honeydew, kiwi and celery may be named).
     #[arg(long, value_delimiter = ',')]
     pub foods: Vec<String>,
     /// Placement settings the trials cycle through (default: isolated,wall,lettuce).
@@ -179,7 +180,11 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     })?;
     let opts = CalibrationOptions {
         roll_by,
-        foods: labels_or_all("--foods", &args.foods)?,
+        foods: if args.foods.is_empty() {
+            FoodKind::SCENE.to_vec()
+        } else {
+            parse_labels("--foods", &args.foods)?
+        },
         settings: labels_or_all("--settings", &args.settings)?,
         trials: args.trials,
         seed: args.seed,

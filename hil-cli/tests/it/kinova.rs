@@ -48,9 +48,9 @@ fn calibrate_prints_rates_beside_the_published_ones() {
     );
     assert!(v["attempts_per_second"].as_f64().unwrap() > 0.0);
 
-    let out = hil(&["kinova", "calibrate", "--foods", "kiwi"]);
+    let out = hil(&["kinova", "calibrate", "--foods", "apple"]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("kiwi"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("apple"));
     let out = hil(&["kinova", "calibrate", "--settings", "bowl"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("bowl"));

@@ -122,6 +122,12 @@ pub const PAPER_W_GRID: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
 /// 10 per (food, action), 180 in all, so that the pretrained estimator's
 /// confidence bonuses are no longer dominated by the prior.
 const PAPER_PRETRAINING_TRIALS: usize = 10;
+/// The foods of the pretraining attempts: none of them is on the plate, as
+/// in the paper. They are derived kinds (`hil_kinova_mujoco::FoodKind`):
+/// published foods with their own colour and their base kind's mechanics
+/// (honeydew from cantaloupe, kiwi from banana, celery from carrot), not
+/// calibrated to the published rates of the foods they are named after.
+pub const PAPER_PRETRAIN_FOODS: [&str; 3] = ["honeydew", "kiwi", "celery"];
 /// The workload model of the study: the paper's simulation model over the
 /// 12 query variables, whose weights are positive, so its forecast never
 /// falls when a query is asked (the fitted `f12_real` forecasts a lower
@@ -144,6 +150,7 @@ fn paper_environment() -> Box<dyn EnvironmentConfig> {
     // As in the study: one item at a time, alone on the plate.
     Box::new(hil_kinova_mujoco::KinovaFeedingConfig {
         pretraining_trials: PAPER_PRETRAINING_TRIALS,
+        pretrain_foods: PAPER_PRETRAIN_FOODS.map(String::from).to_vec(),
         settings: vec!["isolated".into()],
         neighbours: false,
         ..Default::default()
@@ -188,7 +195,7 @@ impl UserStudyConfig {
     /// The paper's real-robot protocol, in the MuJoCo scene: a plate of
     /// banana, baby carrot and cantaloupe, each item alone on the plate
     /// (`kinova_feeding`, `isolated`, 10 simulated pretraining attempts per
-    /// food and action); N_att = 3, WL_0 = 0.5; LinUCB, AlwaysQuery and
+    /// food and action on foods off the plate, [`PAPER_PRETRAIN_FOODS`]); N_att = 3, WL_0 = 0.5; LinUCB, AlwaysQuery and
     /// LinUCB-QG (α = 0.5, pretrained, w chosen from [`PAPER_W_GRID`] by
     /// mean M_wt(0.7) over 4 validation plates per value); the bundled `f12_sim`
     /// workload model (a query never lowers its forecast); a perfect `simulated_expert`

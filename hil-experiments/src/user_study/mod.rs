@@ -17,6 +17,7 @@
 //! [environment]             # built once, shared by every plate
 //! type = "kinova_feeding"
 //! pretraining_trials = 10
+//! pretrain_foods = ["honeydew", "kiwi", "celery"]   # off the plate
 //! settings = ["isolated"]
 //! neighbours = false
 //! [workload]

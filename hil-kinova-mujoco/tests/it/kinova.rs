@@ -206,9 +206,9 @@ fn missing_and_malformed_mjcf_files_are_clear_errors() {
 
 #[test]
 fn config_rejects_unknown_foods_and_fields() {
-    let bad: Result<KinovaFeedingConfig, _> = toml::from_str("plate = [\"kiwi\"]");
+    let bad: Result<KinovaFeedingConfig, _> = toml::from_str("plate = [\"apple\"]");
     let err = KinovaFeedingEnv::new(bad.unwrap()).unwrap_err();
-    assert!(err.to_string().contains("kiwi"), "{err}");
+    assert!(err.to_string().contains("apple"), "{err}");
     let unknown: Result<KinovaFeedingConfig, _> = toml::from_str("colour = 3");
     assert!(unknown.is_err());
 }

@@ -3,3 +3,5 @@
 
 mod kinova;
 mod kinova_hold_roll;
+mod kinova_pretrain;
+mod kinova_step;

@@ -1,0 +1,96 @@
+//! The long step of the phases in which no tine cuts (settling, the move to
+//! the pre-pose, the hold) gives the outcomes of the model's own 1 ms step,
+//! and MuJoCo's warnings stay out of the working directory.
+
+use hil_kinova_mujoco::controller::ACTIONS;
+use hil_kinova_mujoco::food::{FoodKind, FoodModel};
+use hil_kinova_mujoco::sim::{FREE_DT, PerceivedTarget, Placement, Simulator};
+use hil_kinova_mujoco::skewer::{MAX_DT, REF_DT};
+use hil_kinova_mujoco::{AttemptReport, KinovaError};
+use rand::SeedableRng;
+
+fn attempt(sim: &mut Simulator, kind: FoodKind, action: usize, seed: u64) -> AttemptReport {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let props = FoodModel::default_for(kind).sample(&mut rng);
+    let items = vec![Placement {
+        props,
+        xy: [0.0, 0.0],
+        yaw: 0.4 * seed as f64,
+    }];
+    let pose = sim.stage(&items, None, kind).unwrap()[0];
+    let perceived = PerceivedTarget {
+        centre: pose.centre,
+        yaw: pose.yaw,
+        half_height: pose.half_extents[2],
+    };
+    sim.execute(&ACTIONS[action], &perceived, None).unwrap()
+}
+
+#[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
+fn the_long_free_step_keeps_the_outcomes_of_the_1_ms_step() {
+    let mut exact = Simulator::new().unwrap();
+    exact.set_free_step(REF_DT).unwrap();
+    let mut fast = Simulator::new().unwrap();
+    assert_eq!(fast.free_step(), FREE_DT);
+    const { assert!(FREE_DT > 2.0 * REF_DT) };
+    // (food, action): cantaloupe TV0 and carrot VS90 are skewered and held;
+    // carrot VS0 is not pierced (four tines need more than 25 N).
+    for (kind, action) in [
+        (FoodKind::Cantaloupe, 2),
+        (FoodKind::Carrot, 1),
+        (FoodKind::Carrot, 0),
+    ] {
+        for seed in 0..3 {
+            let a = attempt(&mut exact, kind, action, seed);
+            let b = attempt(&mut fast, kind, action, seed);
+            let what = format!("{} {} seed {seed}", kind.name(), ACTIONS[action].name);
+            assert_eq!(a.success, b.success, "{what}: {a:?} vs {b:?}");
+            assert!(
+                (a.final_height - b.final_height).abs() < 0.002,
+                "{what}: final height {} vs {}",
+                a.final_height,
+                b.final_height
+            );
+            assert!(b.hold_slip < 0.002, "{what}: slip {} m", b.hold_slip);
+            // Fewer steps for the same simulated time.
+            assert!(
+                b.steps * 2 < a.steps,
+                "{what}: {} vs {} steps",
+                b.steps,
+                a.steps
+            );
+            assert!((a.sim_time - b.sim_time).abs() < 0.05, "{what}");
+        }
+    }
+}
+
+#[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
+fn a_free_step_beyond_what_the_coupling_tolerates_is_rejected() {
+    let mut sim = Simulator::new().unwrap();
+    for bad in [0.0, -0.001, 2.0 * MAX_DT, f64::NAN] {
+        assert!(matches!(
+            sim.set_free_step(bad),
+            Err(KinovaError::InvalidFreeStep { .. })
+        ));
+    }
+    sim.set_free_step(MAX_DT).unwrap();
+}
+
+#[test]
+#[ignore = "e2e: needs MuJoCo; bash scripts/test runs it"]
+fn mujoco_warnings_are_not_written_to_the_working_directory() {
+    let log = std::path::Path::new("MUJOCO_LOG.TXT");
+    let before = log.exists();
+    let _sim = Simulator::new().unwrap();
+    mujoco_rs::wrappers::mj_logging::log_warning("hil-kinova-mujoco test warning");
+    if !before {
+        let written = log.exists();
+        let _ = std::fs::remove_file(log);
+        assert!(
+            !written,
+            "MuJoCo wrote MUJOCO_LOG.TXT into the working directory"
+        );
+    }
+}

@@ -14,9 +14,11 @@
 //! or dropping the environment) disconnects the remote, whose next `decide`
 //! fails, which ends the worker's session.
 
+use std::path::Path;
 use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 use hil_core::config::{
     EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig, check_session_limits,
@@ -584,6 +586,10 @@ struct PolicyState {
     wl0: f64,
     /// Queries asked through `decide`, for its forecasts.
     history: QueryHistory,
+    /// Time spent inside the policy's own `decide` and `observe` by the
+    /// standalone methods, so that a benchmark can tell the policy's cost
+    /// from the cost of crossing from Python.
+    inner: Duration,
 }
 
 impl NativePolicy {
@@ -594,6 +600,7 @@ impl NativePolicy {
                 forecast,
                 wl0,
                 history: QueryHistory::new(),
+                inner: Duration::ZERO,
             }),
         }
     }
@@ -762,7 +769,9 @@ impl NativePolicy {
                 t,
                 WorkloadForecast::new(Some(forecast.as_ref()), state.wl0, &history, t),
             );
+            let start = Instant::now();
             let chosen = state.choose(&input);
+            state.inner += start.elapsed();
             state.history = history;
             let (arm, kind) = chosen?;
             if let Some(kind) = kind {
@@ -788,11 +797,22 @@ impl NativePolicy {
         let mut guard = self.state()?;
         let state: &mut PolicyState = &mut guard;
         py.detach(|| {
-            state
+            let start = Instant::now();
+            let r = state
                 .policy
-                .observe(&Feedback::new(&context, ArmId(arm), reward, t).from_expert(from_expert))
+                .observe(&Feedback::new(&context, ArmId(arm), reward, t).from_expert(from_expert));
+            state.inner += start.elapsed();
+            r
         })
         .map_err(to_py_err)
+    }
+
+    /// Seconds spent inside the policy's own `decide` and `observe` by
+    /// the standalone `decide` / `observe` calls so far (the rest of a
+    /// call's time is the crossing from Python).
+    #[getter]
+    fn inner_seconds(&self) -> PyResult<f64> {
+        Ok(self.state()?.inner.as_secs_f64())
     }
 }
 
@@ -804,6 +824,88 @@ fn paper_food_split_json() -> PyResult<String> {
         .map_err(|e| to_py_err(HilError::serde("the paper's food split", e)))
 }
 
+// --- Study helpers for hil.envs' example (`examples/workload_study.py`):
+// the smallest native surface that loads a study, selects and fits a
+// workload model, in the same steps as `hil workload select` / `fit`.
+
+/// Cross-validates every candidate workload model on D1, D2 and D12 of the
+/// study CSV at `path` (`hil workload select`), returning the selection
+/// table as JSON (`rows`, each with `dataset`, `candidate`, the test MSEs
+/// and their `median`). `threads` = 0 uses every core.
+#[pyfunction]
+#[pyo3(signature = (path, threads = 0, seed = 0))]
+fn study_select_json(py: Python<'_>, path: &str, threads: usize, seed: u64) -> PyResult<String> {
+    use hil_workload::datasets::{Dataset, DatasetId};
+    use hil_workload::select::{Candidate, SelectOptions, cross_validate};
+    py.detach(|| -> hil_core::Result<String> {
+        let study = hil_workload::study::Study::load(Path::new(path))?;
+        let sets: Vec<Dataset> = DatasetId::ALL
+            .iter()
+            .map(|&id| Dataset::build(&study, id))
+            .collect::<hil_core::Result<_>>()?;
+        let refs: Vec<&Dataset> = sets.iter().collect();
+        let opts = SelectOptions {
+            seed,
+            threads,
+            ..SelectOptions::default()
+        };
+        let table = cross_validate(&refs, &Candidate::table(&opts.histories), &opts)?;
+        Ok(table.to_json())
+    })
+    .map_err(to_py_err)
+}
+
+/// Fits `candidate_json` (a `candidate` of [`study_select_json`]'s rows,
+/// e.g. `{"family": "exp_impulse"}`) on the `population` dataset (`d1`,
+/// `d2`, `d12`) of the study CSV at `path` (as `hil workload fit` does),
+/// returning the model file's JSON, which a `{"type": "model_file",
+/// "path": ...}` workload table loads.
+#[pyfunction]
+#[pyo3(signature = (path, population, candidate_json, seed = 0))]
+fn study_fit_json(
+    py: Python<'_>,
+    path: &str,
+    population: &str,
+    candidate_json: &str,
+    seed: u64,
+) -> PyResult<String> {
+    use hil_workload::datasets::{Dataset, DatasetId};
+    use hil_workload::models::{FittedModel, Provenance};
+    use hil_workload::select::{Candidate, SelectOptions, fit_on_all};
+    let cand: Candidate = parse_json("workload candidate", candidate_json).map_err(to_py_err)?;
+    let fitted = py
+        .detach(|| -> hil_core::Result<FittedModel> {
+            let study = hil_workload::study::Study::load(Path::new(path))?;
+            let id = DatasetId::parse(population)?;
+            let d = Dataset::build(&study, id)?;
+            let opts = SelectOptions {
+                seed,
+                ..SelectOptions::default()
+            };
+            let (spec, lambda) = fit_on_all(&d, cand, &opts)?;
+            let name = format!(
+                "{}_{}{}",
+                cand.label(),
+                id.as_str(),
+                cand.history().map_or(String::new(), |h| format!("_h{h}"))
+            );
+            Ok(FittedModel::new(
+                name,
+                spec,
+                Provenance {
+                    dataset: Some(id.as_str().into()),
+                    data: Some(path.to_string()),
+                    n_pairs: Some(d.pairs.len()),
+                    cv_test_mse: None,
+                    note: lambda.map(|l| format!("ridge λ = {l} chosen by 5-fold CV")),
+                },
+            ))
+        })
+        .map_err(to_py_err)?;
+    serde_json::to_string_pretty(&fitted)
+        .map_err(|e| to_py_err(HilError::serde("fitted workload model", e)))
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // Keep the crates whose components configs name (typetag) linked.
     hil_envs::link();
@@ -813,5 +915,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<GymCore>()?;
     m.add_class::<NativePolicy>()?;
     m.add_function(wrap_pyfunction!(paper_food_split_json, m)?)?;
+    m.add_function(wrap_pyfunction!(study_select_json, m)?)?;
+    m.add_function(wrap_pyfunction!(study_fit_json, m)?)?;
     Ok(())
 }

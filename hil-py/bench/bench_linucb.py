@@ -137,7 +137,8 @@ def make_contextualbandits(w: Workload):
     from contextualbandits.online import LinUCB
 
     x, a, r = w.pretrain
-    m = LinUCB(nchoices=ARMS, alpha=ALPHA, lambda_=1.0, fit_intercept=False, random_state=0)
+    m = LinUCB(nchoices=ARMS, alpha=ALPHA, lambda_=1.0, fit_intercept=False, use_float=False,
+               random_state=0)
     m.fit(x, a, r)
 
     def decide(ctx: np.ndarray) -> int:

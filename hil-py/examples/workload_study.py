@@ -38,6 +38,8 @@ def parse_args(argv=None):
     ap = argparse.ArgumentParser(description="workload study -> model -> LinUCB-QG -> plot")
     ap.add_argument("--study", type=Path, default=STUDY, help="study CSV (hil's study format)")
     ap.add_argument("--population", default="d12", help="dataset to select on: d1, d2 or d12")
+    ap.add_argument("--histories", default="1,5,10,15,20,25,30",
+                    help="Granger history lengths H to cross-validate (comma-separated)")
     ap.add_argument("--episodes", type=int, default=5, help="episodes (seeds 0..n-1)")
     ap.add_argument("--items", type=int, default=5, help="items per episode (a plate)")
     ap.add_argument("--w", type=float, default=4.0, help="LinUCB-QG's workload weight w")
@@ -49,7 +51,8 @@ def main(argv=None) -> dict:
     args = parse_args(argv)
 
     # %% 1-2. Select a workload model on the study and fit it on all of it.
-    table = json.loads(native.study_select_json(str(args.study)))
+    histories = [int(h) for h in args.histories.split(",") if h]
+    table = json.loads(native.study_select_json(str(args.study), histories))
     rows = [r for r in table["rows"] if r["dataset"] == args.population]
     best = min(rows, key=lambda r: r["median"])
     cand = best["candidate"]

@@ -831,10 +831,17 @@ fn paper_food_split_json() -> PyResult<String> {
 /// Cross-validates every candidate workload model on D1, D2 and D12 of the
 /// study CSV at `path` (`hil workload select`), returning the selection
 /// table as JSON (`rows`, each with `dataset`, `candidate`, the test MSEs
-/// and their `median`). `threads` = 0 uses every core.
+/// and their `median`). `histories` are the Granger history lengths tried
+/// (None: hil's default grid, 1 to 30); `threads` = 0 uses every core.
 #[pyfunction]
-#[pyo3(signature = (path, threads = 0, seed = 0))]
-fn study_select_json(py: Python<'_>, path: &str, threads: usize, seed: u64) -> PyResult<String> {
+#[pyo3(signature = (path, histories = None, threads = 0, seed = 0))]
+fn study_select_json(
+    py: Python<'_>,
+    path: &str,
+    histories: Option<Vec<usize>>,
+    threads: usize,
+    seed: u64,
+) -> PyResult<String> {
     use hil_workload::datasets::{Dataset, DatasetId};
     use hil_workload::select::{Candidate, SelectOptions, cross_validate};
     py.detach(|| -> hil_core::Result<String> {
@@ -844,10 +851,12 @@ fn study_select_json(py: Python<'_>, path: &str, threads: usize, seed: u64) -> P
             .map(|&id| Dataset::build(&study, id))
             .collect::<hil_core::Result<_>>()?;
         let refs: Vec<&Dataset> = sets.iter().collect();
+        let defaults = SelectOptions::default();
         let opts = SelectOptions {
+            histories: histories.unwrap_or(defaults.histories.clone()),
             seed,
             threads,
-            ..SelectOptions::default()
+            ..defaults
         };
         let table = cross_validate(&refs, &Candidate::table(&opts.histories), &opts)?;
         Ok(table.to_json())

@@ -20,7 +20,8 @@ def load_example():
 
 def test_workload_study_example_writes_its_plot(tmp_path):
     out = tmp_path / "rollout.png"
-    result = load_example().main(["--episodes", "2", "--items", "2", "--out", str(out)])
+    result = load_example().main(["--episodes", "2", "--items", "2", "--histories", "1",
+                                   "--out", str(out)])
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert len(result["metrics"]) == 2
     assert all(m["n_items"] == 2 for m in result["metrics"])

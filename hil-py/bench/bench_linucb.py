@@ -18,9 +18,9 @@ standard error over repeats of the per-repeat means.
 
 For hil, the time spent inside the policy (Rust ``decide`` + ``observe``,
 measured in Rust around the calls) is subtracted from the time measured in
-Python around the same calls: that difference is the per-step cost of
-crossing from Python into Rust (argument conversion, the GIL release,
-the error mapping).
+Python around the same calls, step by step: the median of that difference
+over a repeat's steps is the per-step cost of crossing from Python into
+Rust (the call, the context's conversion and check, the GIL release).
 
 Run (release build of hil, bench packages installed)::
 
@@ -138,7 +138,7 @@ def make_contextualbandits(w: Workload):
 
     x, a, r = w.pretrain
     m = LinUCB(nchoices=ARMS, alpha=ALPHA, lambda_=1.0, fit_intercept=False, use_float=False,
-               random_state=0)
+               random_state=1)
     m.fit(x, a, r)
 
     def decide(ctx: np.ndarray) -> int:
@@ -156,11 +156,17 @@ def make_numpy(w: Workload):
     return m.decide, (lambda ctx, arm, reward, expert: m.observe(ctx, arm, reward)), None
 
 
-def time_steps(w: Workload, decide: Callable, observe: Callable, steps: int, n_arms: int = ARMS):
-    """Per-step seconds of decide + observe (the reward draw not timed)."""
-    out = []
+def time_steps(w: Workload, decide: Callable, observe: Callable, steps: int, n_arms: int = ARMS,
+               native=None, inner_out: Optional[list] = None):
+    """Per-step seconds of decide + observe (the reward draw not timed).
+
+    With ``native`` (a hil NativePolicy), the seconds spent inside the
+    policy at each step are appended to ``inner_out``.
+    """
+    out, inner = [], []
     for _ in range(steps + 2):  # two warm-up steps
         x = w.contexts(1)[0]
+        before = native.inner_seconds if native is not None else 0.0
         t0 = time.perf_counter()
         arm = decide(x)
         t1 = time.perf_counter()
@@ -172,6 +178,10 @@ def time_steps(w: Workload, decide: Callable, observe: Callable, steps: int, n_a
         observe(x, arm, reward, expert)
         t3 = time.perf_counter()
         out.append((t1 - t0) + (t3 - t2))
+        if native is not None:
+            inner.append(native.inner_seconds - before)
+    if inner_out is not None:
+        inner_out.extend(inner[2:])
     return out[2:]
 
 
@@ -201,6 +211,7 @@ def main(argv: Optional[list[str]] = None) -> dict:
     }
     libs = [s for s in args.libs.split(",") if s]
     per_repeat: dict[str, list[float]] = {lib: [] for lib in libs}
+    medians: dict[str, list[float]] = {lib: [] for lib in libs}
     overhead: list[float] = []
     steps_used: dict[str, int] = {}
     for rep in range(args.repeats):
@@ -210,13 +221,14 @@ def main(argv: Optional[list[str]] = None) -> dict:
             probe = time_steps(w, decide, observe, 2)
             steps = args.steps if statistics.fmean(probe) < 0.02 else args.slow_steps
             steps_used[lib] = steps
-            inner0 = native.inner_seconds if native is not None else 0.0
-            times = time_steps(w, decide, observe, steps)
+            inner: list[float] = []
+            times = time_steps(w, decide, observe, steps, native=native, inner_out=inner)
             per_repeat[lib].append(statistics.fmean(times))
+            medians[lib].append(statistics.median(times))
             if native is not None:
-                # time_steps ran steps + 2 warm-up steps through the policy.
-                inner = (native.inner_seconds - inner0) / (steps + 2)
-                overhead.append(statistics.fmean(times) - inner)
+                # Median over steps of (time in Python - time inside the
+                # policy): robust to a step preempted on a shared machine.
+                overhead.append(statistics.median(t - i for t, i in zip(times, inner)))
             print(f"repeat {rep} {lib}: {statistics.fmean(times) * 1e6:.1f} us/step "
                   f"over {steps} steps", file=sys.stderr)
     result = {
@@ -224,6 +236,9 @@ def main(argv: Optional[list[str]] = None) -> dict:
         "repeats": args.repeats,
         "load_average_1m": os.getloadavg()[0],
         "us_per_step": {lib: [v * 1e6 for v in mean_se(per_repeat[lib])] for lib in libs},
+        # The median step of each repeat (mean +- SE over repeats): the
+        # statistic `hil bench policy` reports for the Rust figure.
+        "median_us_per_step": {lib: [v * 1e6 for v in mean_se(medians[lib])] for lib in libs},
         "steps_per_repeat": steps_used,
         "data": "synthetic",
     }
@@ -236,8 +251,9 @@ def main(argv: Optional[list[str]] = None) -> dict:
               f"{args.repeats} repeats (mean +- SE over repeats; synthetic data)")
         for lib in libs:
             m, se = result["us_per_step"][lib]
-            print(f"  {lib:18s} {m:12.1f} +- {se:8.1f} us per decide + observe "
-                  f"({steps_used[lib]} steps per repeat)")
+            md, mdse = result["median_us_per_step"][lib]
+            print(f"  {lib:18s} mean {m:12.1f} +- {se:8.1f} us, median {md:12.1f} +- {mdse:8.1f} us"
+                  f" per decide + observe ({steps_used[lib]} steps per repeat)")
         if overhead:
             m, se = result["hil_crossing_us_per_step"]
             print(f"  hil crossing from Python: {m:.2f} +- {se:.2f} us per step (decide + observe)")

@@ -628,7 +628,7 @@ fn context_of(x: &PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
     let values = x
         .as_slice()
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Context::new(values.to_vec()).map_err(to_py_err)
+    Context::new(values).map_err(to_py_err)
 }
 
 #[pymethods]

@@ -1,7 +1,930 @@
-//! Native support of `hil.envs` (work in progress on its own branch).
+//! Native engine of `hil.envs`: hil's session loop driven one decision at a
+//! time by a Gymnasium agent, and a native policy to drive it with.
+//!
+//! A Gymnasium environment hands control to the agent at every step, while
+//! hil's [`Session`] owns its loop. Rather than re-implementing the loop
+//! (items, attempts, following the expert after a query, the workload
+//! tracker, the checks), the episode runs the real `Session::run_episode` on
+//! a worker thread whose policy is a remote: each `Policy::decide` sends the
+//! decision input to [`GymCore`] and blocks until the agent's action comes
+//! back. So a Gymnasium step is exactly one decision of the policy, followed
+//! by every attempt the session executes before it asks the policy again
+//! (one attempt after an autonomous action; after a query, the expert's arm
+//! repeated until success or `n_att`). Abandoning an episode (a new `reset`,
+//! or dropping the environment) disconnects the remote, whose next `decide`
+//! fails, which ends the worker's session.
 
+use std::path::Path;
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use hil_core::config::{
+    EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig, check_session_limits,
+};
+use hil_core::{
+    ActionSpace, ArmId, BuildContext, Choice, Context, Decision, DecisionInput, Environment,
+    EpisodeReport, Feedback, HilError, LabelledObservation, Policy, QueryChannel, QueryHistory,
+    QueryKind, Session, SessionObserver, SessionSettings, StepEvent, TaskContext, Timestep,
+    WorkloadForecast, WorkloadModel,
+};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use serde::Deserialize;
 
-pub(crate) fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+use crate::errors::to_py_err;
+
+/// What the environment of a [`GymCore`] is made of (JSON from Python):
+/// the session settings, the environment, workload model and query channel
+/// exactly as in an experiment config, and how the "ask" action asks.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GymConfig {
+    /// Seed of the components' construction (e.g. the pretraining data);
+    /// episodes are seeded by `reset`.
+    #[serde(default)]
+    build_seed: u64,
+    #[serde(default)]
+    session: SessionSettings,
+    #[serde(deserialize_with = "hil_core::plugin::component")]
+    environment: Box<dyn EnvironmentConfig>,
+    #[serde(deserialize_with = "hil_core::plugin::component")]
+    workload: Box<dyn WorkloadModelConfig>,
+    #[serde(deserialize_with = "hil_core::plugin::component")]
+    channel: Box<dyn QueryChannelConfig>,
+    /// What the "ask" action asks.
+    #[serde(default)]
+    query_kind: QueryKind,
+    /// The arm executed when the channel gives no arm back (a declined or
+    /// timed-out query); the default simulated expert always answers.
+    #[serde(default)]
+    fallback_arm: usize,
+}
+
+fn parse_json<T: serde::de::DeserializeOwned>(what: &str, json: &str) -> Result<T, HilError> {
+    serde_json::from_str(json).map_err(|e| HilError::serde(what.to_string(), e))
+}
+
+/// What the agent sees when it must decide: the session's decision input.
+#[derive(Clone, Debug)]
+struct Pending {
+    context: Context,
+    t: Timestep,
+    item_index: usize,
+    item_label: String,
+    items_seen: usize,
+    attempt: u32,
+    wl0: f64,
+    history: QueryHistory,
+    wl_now: f64,
+    wl_if_ask: f64,
+}
+
+/// Messages from the session's thread to the environment.
+enum FromSession {
+    ItemStart(String),
+    Decide(Box<Pending>),
+    Executed(Box<StepEvent>),
+    Finished(Box<hil_core::Result<EpisodeReport>>),
+}
+
+/// The policy of the worker's session: it forwards each decision to the
+/// agent. It learns nothing itself (the agent learns from `info`).
+struct RemotePolicy {
+    n_arms: usize,
+    dim: usize,
+    kind: QueryKind,
+    fallback: ArmId,
+    to_gym: Sender<FromSession>,
+    actions: Receiver<usize>,
+}
+
+impl Policy for RemotePolicy {
+    fn name(&self) -> &str {
+        "gymnasium_agent"
+    }
+    fn n_arms(&self) -> usize {
+        self.n_arms
+    }
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn decide(&mut self, input: &DecisionInput<'_>) -> hil_core::Result<Decision> {
+        let pending = Pending {
+            context: input.context.clone(),
+            t: input.t,
+            item_index: input.item_index,
+            item_label: String::new(), // filled in by the environment
+            items_seen: input.items_seen,
+            attempt: input.attempt,
+            wl0: input.workload.wl0(),
+            history: input.workload.history().clone(),
+            wl_now: input.workload.now()?,
+            wl_if_ask: input.workload.if_queried(self.kind)?,
+        };
+        let abandoned = || HilError::state("gymnasium agent", "the episode was abandoned");
+        self.to_gym
+            .send(FromSession::Decide(Box::new(pending)))
+            .map_err(|_| abandoned())?;
+        let action = self.actions.recv().map_err(|_| abandoned())?;
+        Ok(if action == self.n_arms {
+            Decision::query(self.kind, self.fallback)
+        } else {
+            Decision::act(ArmId(action))
+        })
+    }
+    fn observe(&mut self, _: &Feedback<'_>) -> hil_core::Result<()> {
+        Ok(())
+    }
+}
+
+/// Forwards each item's start and every executed step. A closed channel
+/// means the episode was abandoned; the remote policy reports that at its
+/// next decision.
+struct Forwarder {
+    to_gym: Sender<FromSession>,
+}
+
+impl SessionObserver for Forwarder {
+    fn on_item_start(&mut self, item: &hil_core::Item) -> hil_core::Result<()> {
+        let _ = self.to_gym.send(FromSession::ItemStart(item.label.clone()));
+        Ok(())
+    }
+    fn on_step(&mut self, event: &StepEvent) -> hil_core::Result<()> {
+        let _ = self
+            .to_gym
+            .send(FromSession::Executed(Box::new(event.clone())));
+        Ok(())
+    }
+}
+
+/// The components a session borrows; they move to the worker for an
+/// episode and come back when it ends.
+struct Parts {
+    environment: Box<dyn Environment>,
+    channel: Box<dyn QueryChannel>,
+}
+
+/// An episode in progress on the worker thread.
+struct Running {
+    actions: Sender<usize>,
+    events: Receiver<FromSession>,
+    worker: JoinHandle<Parts>,
+}
+
+struct Engine {
+    parts: Option<Parts>,
+    running: Option<Running>,
+    /// The decision the agent owes, if any.
+    pending: Option<Pending>,
+    /// The attempts executed by the last step.
+    executed: Vec<StepEvent>,
+    /// The label of the item being attempted.
+    item_label: String,
+    report: Option<EpisodeReport>,
+}
+
+/// The session loop driven one decision at a time (the engine of
+/// `hil.envs.HilEnv`; see that class for the Gymnasium semantics).
+#[pyclass(module = "hil._hil", frozen)]
+pub(crate) struct GymCore {
+    settings: SessionSettings,
+    workload: Arc<dyn WorkloadModel>,
+    task: TaskContext,
+    kind: QueryKind,
+    fallback: ArmId,
+    environment_name: String,
+    engine: Mutex<Engine>,
+}
+
+impl GymCore {
+    fn engine(&self) -> PyResult<MutexGuard<'_, Engine>> {
+        self.engine
+            .lock()
+            .map_err(|_| to_py_err(HilError::state("gymnasium environment", "a step panicked")))
+    }
+}
+
+impl Engine {
+    /// Ends the running episode, if any, and takes its components back.
+    fn stop(&mut self) -> hil_core::Result<()> {
+        if let Some(run) = self.running.take() {
+            drop(run.actions);
+            drop(run.events);
+            let parts = run.worker.join().map_err(|_| {
+                HilError::state("gymnasium environment", "the session's thread panicked")
+            })?;
+            self.parts = Some(parts);
+        }
+        Ok(())
+    }
+
+    /// Collects what the session does until it asks the agent again or the
+    /// episode ends.
+    fn advance(&mut self) -> hil_core::Result<()> {
+        self.executed.clear();
+        let Some(run) = &self.running else {
+            return Err(HilError::state(
+                "gymnasium environment",
+                "no episode is running: call reset()",
+            ));
+        };
+        loop {
+            let message = run.events.recv().map_err(|_| {
+                HilError::state("gymnasium environment", "the session's thread ended early")
+            })?;
+            match message {
+                FromSession::ItemStart(label) => self.item_label = label,
+                FromSession::Executed(e) => self.executed.push(*e),
+                FromSession::Decide(mut p) => {
+                    p.item_label.clone_from(&self.item_label);
+                    self.pending = Some(*p);
+                    return Ok(());
+                }
+                FromSession::Finished(result) => {
+                    self.pending = None;
+                    self.stop()?;
+                    self.report = Some((*result)?);
+                    return Ok(());
+                }
+            }
+        }
+    }
+}
+
+impl Drop for GymCore {
+    fn drop(&mut self) {
+        if let Ok(engine) = self.engine.get_mut() {
+            let _ = engine.stop();
+        }
+    }
+}
+
+fn context_array<'py>(py: Python<'py>, c: &Context) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, c.as_slice())
+}
+
+#[pymethods]
+impl GymCore {
+    /// Builds the environment, workload model and query channel from
+    /// `config_json` (keys `session`, `environment`, `workload`, `channel`,
+    /// and optionally `build_seed`, `query_kind`, `fallback_arm`; the
+    /// components' tables as in an experiment config). Relative paths
+    /// resolve against `base_dir`.
+    #[new]
+    #[pyo3(signature = (config_json, base_dir = "."))]
+    fn new(py: Python<'_>, config_json: &str, base_dir: &str) -> PyResult<Self> {
+        let config: GymConfig = parse_json("environment config", config_json).map_err(to_py_err)?;
+        py.detach(|| Self::build(config, base_dir))
+            .map_err(to_py_err)
+    }
+
+    /// Number of robot actions (the "ask" action is `n_arms`).
+    #[getter]
+    fn n_arms(&self) -> usize {
+        self.task.action_space().len()
+    }
+
+    /// Context dimension.
+    #[getter]
+    fn dim(&self) -> usize {
+        self.task.context_dim()
+    }
+
+    /// The robot actions' names, in arm order.
+    #[getter]
+    fn action_names(&self) -> Vec<String> {
+        self.task.action_space().names().to_vec()
+    }
+
+    /// The environment's name.
+    #[getter]
+    fn environment_name(&self) -> String {
+        self.environment_name.clone()
+    }
+
+    /// Starts the episode seeded by `seed` (abandoning any running one) and
+    /// returns the first context and the decision info.
+    fn reset<'py>(
+        &self,
+        py: Python<'py>,
+        seed: u64,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+        let mut guard = self.engine()?;
+        let engine: &mut Engine = &mut guard;
+        py.detach(|| self.start(engine, seed)).map_err(to_py_err)?;
+        let Some(p) = &engine.pending else {
+            return Err(to_py_err(HilError::state(
+                "gymnasium environment",
+                format!(
+                    "`{}` ended its episode before the first decision (no items)",
+                    self.environment_name
+                ),
+            )));
+        };
+        let info = PyDict::new(py);
+        pending_info(&info, p)?;
+        Ok((context_array(py, &p.context), info))
+    }
+
+    /// Takes action `action` (an arm, or `n_arms` to ask) and returns
+    /// `(observation, task_reward, wl_before, wl_after, terminated, info)`.
+    #[allow(clippy::type_complexity)]
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        action: usize,
+    ) -> PyResult<(
+        Bound<'py, PyArray1<f64>>,
+        f64,
+        f64,
+        f64,
+        bool,
+        Bound<'py, PyDict>,
+    )> {
+        let n_arms = self.n_arms();
+        if action > n_arms {
+            return Err(PyValueError::new_err(format!(
+                "action {action} is outside 0..={n_arms} (arms 0..{n_arms}, {n_arms} = ask)"
+            )));
+        }
+        let mut guard = self.engine()?;
+        let engine: &mut Engine = &mut guard;
+        let Some(before) = engine.pending.take() else {
+            return Err(to_py_err(HilError::state(
+                "gymnasium environment",
+                "the episode has ended: call reset()",
+            )));
+        };
+        let sent = engine
+            .running
+            .as_ref()
+            .is_some_and(|r| r.actions.send(action).is_ok());
+        if !sent {
+            return Err(to_py_err(HilError::state(
+                "gymnasium environment",
+                "the session's thread ended early",
+            )));
+        }
+        py.detach(|| engine.advance()).map_err(to_py_err)?;
+        let engine: &Engine = engine;
+
+        let info = PyDict::new(py);
+        let executed = &engine.executed;
+        let reward: f64 = executed.iter().map(StepEvent::task_reward).sum();
+        let wl_after = executed.last().map_or(before.wl_now, |e| e.step.wl_t);
+        let (mut asked, mut expert_arm) = (false, None);
+        for e in executed {
+            if e.step.decision.is_query() {
+                asked = true;
+                expert_arm = e.step.response.as_ref().and_then(|r| r.expert_arm);
+            }
+        }
+        let d = self.dim();
+        let mut contexts = Vec::with_capacity(executed.len() * d);
+        for e in executed {
+            contexts.extend_from_slice(e.step.context.as_slice());
+        }
+        let contexts = Array2::from_shape_vec((executed.len(), d), contexts)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        info.set_item("asked", asked)?;
+        info.set_item("expert_arm", expert_arm.map(|a: ArmId| a.0))?;
+        info.set_item("item_success", executed.iter().any(|e| e.outcome.success))?;
+        info.set_item(
+            "executed_arms",
+            executed.iter().map(|e| e.step.arm.0).collect::<Vec<_>>(),
+        )?;
+        info.set_item(
+            "executed_rewards",
+            executed
+                .iter()
+                .map(|e| e.outcome.reward())
+                .collect::<Vec<_>>(),
+        )?;
+        info.set_item("executed_from_expert", from_expert(executed))?;
+        info.set_item("executed_contexts", contexts.into_pyarray(py))?;
+        info.set_item("wl_t", wl_after)?;
+        let (obs, terminated) = match &engine.pending {
+            Some(p) => {
+                pending_info(&info, p)?;
+                (context_array(py, &p.context), false)
+            }
+            None => {
+                if let Some(report) = &engine.report {
+                    let json = serde_json::to_string(&report.metrics)
+                        .map_err(|e| to_py_err(HilError::serde("episode metrics", e)))?;
+                    info.set_item("episode_json", json)?;
+                }
+                // Gymnasium wants an observation at the end too: the last
+                // context the agent saw.
+                (context_array(py, &before.context), true)
+            }
+        };
+        Ok((obs, reward, before.wl_now, wl_after, terminated, info))
+    }
+
+    /// A hil policy for this environment, from its config table as JSON
+    /// (e.g. `{"type": "linucb_qg", "alpha": 0.5, "w": 4.0, "pretrain":
+    /// true}`), built exactly as an experiment would build it (with the
+    /// environment's pretraining data); it forecasts workload with this
+    /// environment's model.
+    fn policy(&self, py: Python<'_>, policy_json: &str) -> PyResult<NativePolicy> {
+        let config: Box<dyn PolicyConfig> =
+            parse_json("policy config", policy_json).map_err(to_py_err)?;
+        let policy = py
+            .detach(|| config.validate().and_then(|()| config.build(&self.task)))
+            .map_err(to_py_err)?;
+        Ok(NativePolicy::new(
+            policy,
+            self.workload.clone(),
+            self.settings.wl0,
+        ))
+    }
+}
+
+impl GymCore {
+    fn build(config: GymConfig, base_dir: &str) -> hil_core::Result<Self> {
+        config.session.validate()?;
+        check_session_limits(&config.session)?;
+        config.environment.validate()?;
+        config.workload.validate()?;
+        config.channel.validate()?;
+        let ctx = BuildContext::new(base_dir, config.build_seed);
+        let environment = config.environment.build(&ctx)?;
+        let task = ctx.describe_environment(config.environment.as_ref(), environment.as_ref())?;
+        let workload = config.workload.build(&ctx)?;
+        let channel = config.channel.build(&task)?;
+        task.action_space()
+            .check(ArmId(config.fallback_arm))
+            .map_err(|e| {
+                HilError::invalid_parameter("fallback_arm", config.fallback_arm, e.to_string())
+            })?;
+        Ok(Self {
+            settings: config.session,
+            workload,
+            kind: config.query_kind,
+            fallback: ArmId(config.fallback_arm),
+            environment_name: environment.name().to_string(),
+            task,
+            engine: Mutex::new(Engine {
+                parts: Some(Parts {
+                    environment,
+                    channel,
+                }),
+                running: None,
+                pending: None,
+                executed: Vec::new(),
+                item_label: String::new(),
+                report: None,
+            }),
+        })
+    }
+
+    /// Starts the worker's session for the episode seeded by `seed` and
+    /// waits for its first decision.
+    fn start(&self, engine: &mut Engine, seed: u64) -> hil_core::Result<()> {
+        engine.stop()?;
+        engine.pending = None;
+        engine.report = None;
+        let mut parts = engine.parts.take().ok_or_else(|| {
+            HilError::state(
+                "gymnasium environment",
+                "its components were lost by a failed episode",
+            )
+        })?;
+        let (to_gym, events) = channel();
+        let (actions_tx, actions) = channel();
+        let mut remote = RemotePolicy {
+            n_arms: self.task.action_space().len(),
+            dim: self.task.context_dim(),
+            kind: self.kind,
+            fallback: self.fallback,
+            to_gym: to_gym.clone(),
+            actions,
+        };
+        let mut forwarder = Forwarder {
+            to_gym: to_gym.clone(),
+        };
+        let settings = self.settings.clone();
+        let workload = self.workload.clone();
+        let worker = std::thread::Builder::new()
+            .name("hil-gym-session".into())
+            .spawn(move || {
+                let result = Session::new(
+                    settings,
+                    parts.environment.as_mut(),
+                    &mut remote,
+                    parts.channel.as_mut(),
+                    workload,
+                )
+                .run_episode(seed, &mut [&mut forwarder]);
+                let _ = to_gym.send(FromSession::Finished(Box::new(result)));
+                parts
+            })
+            .map_err(|e| {
+                HilError::state(
+                    "gymnasium environment",
+                    format!("cannot start its thread: {e}"),
+                )
+            })?;
+        engine.running = Some(Running {
+            actions: actions_tx,
+            events,
+            worker,
+        });
+        engine.advance()
+    }
+}
+
+/// For each executed attempt, whether its arm came from the expert (the
+/// session's `Feedback::from_expert`): from an answered query on, every
+/// attempt at the item executes the expert's arm.
+fn from_expert(executed: &[StepEvent]) -> Vec<bool> {
+    let mut answered = false;
+    executed
+        .iter()
+        .map(|e| {
+            if e.step.decision.is_query() {
+                answered = e
+                    .step
+                    .response
+                    .as_ref()
+                    .is_some_and(|r| r.expert_arm.is_some());
+            }
+            answered
+        })
+        .collect()
+}
+
+fn pending_info(info: &Bound<'_, PyDict>, p: &Pending) -> PyResult<()> {
+    info.set_item("t", p.t)?;
+    info.set_item("item_index", p.item_index)?;
+    info.set_item("item_label", &p.item_label)?;
+    info.set_item("items_seen", p.items_seen)?;
+    info.set_item("attempt", p.attempt)?;
+    info.set_item("workload", p.wl_now)?;
+    info.set_item("workload_if_ask", p.wl_if_ask)?;
+    info.set_item("n_queries", p.history.len())?;
+    Ok(())
+}
+
+/// A hil policy (any built-in or plugin type) driven from Python: through
+/// a [`GymCore`]'s decisions (`act` / `learn`), or on its own (`decide` /
+/// `observe`, keeping its own query history for the workload forecast).
+#[pyclass(module = "hil._hil", frozen)]
+pub(crate) struct NativePolicy {
+    inner: Mutex<PolicyState>,
+}
+
+struct PolicyState {
+    policy: Box<dyn Policy>,
+    forecast: Arc<dyn WorkloadModel>,
+    wl0: f64,
+    /// Queries asked through `decide`, for its forecasts.
+    history: QueryHistory,
+    /// Time spent inside the policy's own `decide` and `observe` by the
+    /// standalone methods, so that a benchmark can tell the policy's cost
+    /// from the cost of crossing from Python.
+    inner: Duration,
+}
+
+impl NativePolicy {
+    fn new(policy: Box<dyn Policy>, forecast: Arc<dyn WorkloadModel>, wl0: f64) -> Self {
+        Self {
+            inner: Mutex::new(PolicyState {
+                policy,
+                forecast,
+                wl0,
+                history: QueryHistory::new(),
+                inner: Duration::ZERO,
+            }),
+        }
+    }
+
+    fn state(&self) -> PyResult<MutexGuard<'_, PolicyState>> {
+        self.inner
+            .lock()
+            .map_err(|_| to_py_err(HilError::state("native policy", "a call panicked")))
+    }
+}
+
+impl PolicyState {
+    fn choose(
+        &mut self,
+        input: &DecisionInput<'_>,
+    ) -> hil_core::Result<(usize, Option<QueryKind>)> {
+        Ok(match self.policy.decide(input)?.choice {
+            Choice::Act { arm } => (arm.0, None),
+            Choice::Query { kind, .. } => (self.policy.n_arms(), Some(kind)),
+        })
+    }
+}
+
+fn context_of(x: &PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
+    let values = x
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Context::new(values).map_err(to_py_err)
+}
+
+#[pymethods]
+impl NativePolicy {
+    /// A policy from its config table as JSON, for `n_arms` arms and
+    /// contexts of dimension `dim`, forecasting workload with the bundled
+    /// model `workload` from `wl0`. `pretrain_contexts` (n × dim),
+    /// `pretrain_arms` and `pretrain_rewards` (length n) are the offline
+    /// data a config with `pretrain = true` fits first.
+    #[new]
+    #[pyo3(signature = (policy_json, n_arms, dim, workload_json, wl0 = 0.5, pretrain_contexts = None, pretrain_arms = None, pretrain_rewards = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn py_new(
+        py: Python<'_>,
+        policy_json: &str,
+        n_arms: usize,
+        dim: usize,
+        workload_json: &str,
+        wl0: f64,
+        pretrain_contexts: Option<PyReadonlyArray2<'_, f64>>,
+        pretrain_arms: Option<Vec<usize>>,
+        pretrain_rewards: Option<Vec<f64>>,
+    ) -> PyResult<Self> {
+        let config: Box<dyn PolicyConfig> =
+            parse_json("policy config", policy_json).map_err(to_py_err)?;
+        let workload: Box<dyn WorkloadModelConfig> =
+            parse_json("workload config", workload_json).map_err(to_py_err)?;
+        hil_core::workload::check_wl0(wl0).map_err(to_py_err)?;
+        let actions =
+            ActionSpace::new((0..n_arms).map(|a| format!("arm{a}"))).map_err(to_py_err)?;
+        let ctx = BuildContext::new(".", 0);
+        let mut task = TaskContext::new(ctx.clone(), actions, dim);
+        match (pretrain_contexts, pretrain_arms, pretrain_rewards) {
+            (None, None, None) => {}
+            (Some(x), Some(arms), Some(rewards)) => {
+                let x = x.as_array();
+                if x.nrows() != arms.len() || x.nrows() != rewards.len() || x.ncols() != dim {
+                    return Err(PyValueError::new_err(format!(
+                        "pretraining data: contexts are {} x {}, arms {} and rewards {} long; expected n x {dim} and n, n",
+                        x.nrows(),
+                        x.ncols(),
+                        arms.len(),
+                        rewards.len()
+                    )));
+                }
+                let mut data = Vec::with_capacity(arms.len());
+                for (i, (&arm, &reward)) in arms.iter().zip(&rewards).enumerate() {
+                    let context = Context::new(x.row(i).to_vec()).map_err(|e| {
+                        to_py_err(HilError::invalid_input(
+                            format!("pretraining context {i}"),
+                            e.to_string(),
+                        ))
+                    })?;
+                    data.push(LabelledObservation {
+                        context,
+                        arm: ArmId(arm),
+                        reward,
+                    });
+                }
+                task = task.with_pretraining(data.into());
+            }
+            _ => {
+                return Err(PyValueError::new_err(
+                    "pretraining data needs all of pretrain_contexts, pretrain_arms and pretrain_rewards",
+                ));
+            }
+        }
+        let (policy, forecast) = py
+            .detach(|| -> hil_core::Result<_> {
+                config.validate()?;
+                workload.validate()?;
+                Ok((config.build(&task)?, workload.build(&ctx)?))
+            })
+            .map_err(to_py_err)?;
+        Ok(Self::new(policy, forecast, wl0))
+    }
+
+    /// The policy's name.
+    #[getter]
+    fn name(&self) -> PyResult<String> {
+        Ok(self.state()?.policy.name().to_string())
+    }
+
+    /// Decides at `env`'s pending decision: an arm, or `n_arms` to ask.
+    fn act(&self, py: Python<'_>, env: &GymCore) -> PyResult<usize> {
+        let engine = env.engine()?;
+        let Some(p) = &engine.pending else {
+            return Err(to_py_err(HilError::state(
+                "gymnasium environment",
+                "no decision is pending: call reset()",
+            )));
+        };
+        let mut guard = self.state()?;
+        let state: &mut PolicyState = &mut guard;
+        py.detach(|| {
+            let forecast = state.forecast.clone();
+            let input = DecisionInput::new(
+                &p.context,
+                p.t,
+                WorkloadForecast::new(Some(forecast.as_ref()), p.wl0, &p.history, p.t),
+            )
+            .at_item(p.item_index, p.items_seen, p.attempt);
+            state.choose(&input).map(|(a, _)| a)
+        })
+        .map_err(to_py_err)
+    }
+
+    /// Learns from every attempt `env`'s last step executed, as the
+    /// session loop would have told the policy.
+    fn learn(&self, py: Python<'_>, env: &GymCore) -> PyResult<()> {
+        let engine = env.engine()?;
+        let executed: &[StepEvent] = &engine.executed;
+        let mut guard = self.state()?;
+        let state: &mut PolicyState = &mut guard;
+        py.detach(|| {
+            for (e, expert) in executed.iter().zip(from_expert(executed)) {
+                state.policy.observe(
+                    &Feedback::new(&e.step.context, e.step.arm, e.outcome.reward(), e.step.t)
+                        .from_expert(expert),
+                )?;
+            }
+            Ok(())
+        })
+        .map_err(to_py_err)
+    }
+
+    /// Decides for context `x` at timestep `t` on its own: an arm, or
+    /// `n_arms` to ask (the query is added to its own history).
+    fn decide(&self, py: Python<'_>, x: PyReadonlyArray1<'_, f64>, t: Timestep) -> PyResult<usize> {
+        let context = context_of(&x)?;
+        let mut guard = self.state()?;
+        let state: &mut PolicyState = &mut guard;
+        py.detach(|| {
+            let forecast = state.forecast.clone();
+            let history = std::mem::take(&mut state.history);
+            let input = DecisionInput::new(
+                &context,
+                t,
+                WorkloadForecast::new(Some(forecast.as_ref()), state.wl0, &history, t),
+            );
+            let start = Instant::now();
+            let chosen = state.choose(&input);
+            state.inner += start.elapsed();
+            state.history = history;
+            let (arm, kind) = chosen?;
+            if let Some(kind) = kind {
+                state.history.push(t, kind)?;
+            }
+            Ok(arm)
+        })
+        .map_err(to_py_err)
+    }
+
+    /// Learns that arm `arm` in context `x` gave `reward` at timestep `t`.
+    #[pyo3(signature = (x, arm, reward, t, from_expert = false))]
+    fn observe(
+        &self,
+        py: Python<'_>,
+        x: PyReadonlyArray1<'_, f64>,
+        arm: usize,
+        reward: f64,
+        t: Timestep,
+        from_expert: bool,
+    ) -> PyResult<()> {
+        let context = context_of(&x)?;
+        let mut guard = self.state()?;
+        let state: &mut PolicyState = &mut guard;
+        py.detach(|| {
+            let start = Instant::now();
+            let r = state
+                .policy
+                .observe(&Feedback::new(&context, ArmId(arm), reward, t).from_expert(from_expert));
+            state.inner += start.elapsed();
+            r
+        })
+        .map_err(to_py_err)
+    }
+
+    /// Seconds spent inside the policy's own `decide` and `observe` by
+    /// the standalone `decide` / `observe` calls so far (the rest of a
+    /// call's time is the crossing from Python).
+    #[getter]
+    fn inner_seconds(&self) -> PyResult<f64> {
+        Ok(self.state()?.inner.as_secs_f64())
+    }
+}
+
+/// The paper's food split (`hil_envs::FoodSplit::paper`) as JSON: keys
+/// `pretrain`, `validation`, `test`, each a list of food names.
+#[pyfunction]
+fn paper_food_split_json() -> PyResult<String> {
+    serde_json::to_string(&hil_envs::FoodSplit::paper())
+        .map_err(|e| to_py_err(HilError::serde("the paper's food split", e)))
+}
+
+// --- Study helpers for hil.envs' example (`examples/workload_study.py`):
+// the smallest native surface that loads a study, selects and fits a
+// workload model, in the same steps as `hil workload select` / `fit`.
+
+/// Cross-validates every candidate workload model on D1, D2 and D12 of the
+/// study CSV at `path` (`hil workload select`), returning the selection
+/// table as JSON (`rows`, each with `dataset`, `candidate`, the test MSEs
+/// and their `median`). `histories` are the Granger history lengths tried
+/// (None: hil's default grid, 1 to 30); `threads` = 0 uses every core.
+#[pyfunction]
+#[pyo3(signature = (path, histories = None, threads = 0, seed = 0))]
+fn study_select_json(
+    py: Python<'_>,
+    path: &str,
+    histories: Option<Vec<usize>>,
+    threads: usize,
+    seed: u64,
+) -> PyResult<String> {
+    use hil_workload::datasets::{Dataset, DatasetId};
+    use hil_workload::select::{Candidate, SelectOptions, cross_validate};
+    py.detach(|| -> hil_core::Result<String> {
+        let study = hil_workload::study::Study::load(Path::new(path))?;
+        let sets: Vec<Dataset> = DatasetId::ALL
+            .iter()
+            .map(|&id| Dataset::build(&study, id))
+            .collect::<hil_core::Result<_>>()?;
+        let refs: Vec<&Dataset> = sets.iter().collect();
+        let defaults = SelectOptions::default();
+        let opts = SelectOptions {
+            histories: histories.unwrap_or(defaults.histories.clone()),
+            seed,
+            threads,
+            ..defaults
+        };
+        let table = cross_validate(&refs, &Candidate::table(&opts.histories), &opts)?;
+        Ok(table.to_json())
+    })
+    .map_err(to_py_err)
+}
+
+/// Fits `candidate_json` (a `candidate` of [`study_select_json`]'s rows,
+/// e.g. `{"family": "exp_impulse"}`) on the `population` dataset (`d1`,
+/// `d2`, `d12`) of the study CSV at `path` (as `hil workload fit` does),
+/// returning the model file's JSON, which a `{"type": "model_file",
+/// "path": ...}` workload table loads.
+#[pyfunction]
+#[pyo3(signature = (path, population, candidate_json, seed = 0))]
+fn study_fit_json(
+    py: Python<'_>,
+    path: &str,
+    population: &str,
+    candidate_json: &str,
+    seed: u64,
+) -> PyResult<String> {
+    use hil_workload::datasets::{Dataset, DatasetId};
+    use hil_workload::models::{FittedModel, Provenance};
+    use hil_workload::select::{Candidate, SelectOptions, fit_on_all};
+    let cand: Candidate = parse_json("workload candidate", candidate_json).map_err(to_py_err)?;
+    let fitted = py
+        .detach(|| -> hil_core::Result<FittedModel> {
+            let study = hil_workload::study::Study::load(Path::new(path))?;
+            let id = DatasetId::parse(population)?;
+            let d = Dataset::build(&study, id)?;
+            let opts = SelectOptions {
+                seed,
+                ..SelectOptions::default()
+            };
+            let (spec, lambda) = fit_on_all(&d, cand, &opts)?;
+            let name = format!(
+                "{}_{}{}",
+                cand.label(),
+                id.as_str(),
+                cand.history().map_or(String::new(), |h| format!("_h{h}"))
+            );
+            Ok(FittedModel::new(
+                name,
+                spec,
+                Provenance {
+                    dataset: Some(id.as_str().into()),
+                    data: Some(path.to_string()),
+                    n_pairs: Some(d.pairs.len()),
+                    cv_test_mse: None,
+                    note: lambda.map(|l| format!("ridge λ = {l} chosen by 5-fold CV")),
+                },
+            ))
+        })
+        .map_err(to_py_err)?;
+    serde_json::to_string_pretty(&fitted)
+        .map_err(|e| to_py_err(HilError::serde("fitted workload model", e)))
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // Keep the crates whose components configs name (typetag) linked.
+    hil_envs::link();
+    hil_channels::link();
+    hil_policies::link();
+    hil_workload::link();
+    m.add_class::<GymCore>()?;
+    m.add_class::<NativePolicy>()?;
+    m.add_function(wrap_pyfunction!(paper_food_split_json, m)?)?;
+    m.add_function(wrap_pyfunction!(study_select_json, m)?)?;
+    m.add_function(wrap_pyfunction!(study_fit_json, m)?)?;
     Ok(())
 }

@@ -46,7 +46,16 @@ from ._hil import (
     select_workload,
 )
 
+import importlib.util as _ilu
+
+from .sweep import protocol_settings, sweep
+
+if _ilu.find_spec("gymnasium") is not None:
+    from . import envs  # noqa: F401  (registers hil/FoodReplay-v0)
+
 __all__ = [
+    "protocol_settings",
+    "sweep",
     "KINOVA",
     "PAPER_ALPHA",
     "AlwaysQuery",

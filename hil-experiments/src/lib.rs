@@ -10,8 +10,10 @@
 //! - [`testbed`]: the paper's simulated-testbed protocol (methods as policy
 //!   configs, runs in parallel, hyperparameters chosen on validation, the
 //!   cross-data experiment);
-//! - [`user_study`]: the paper's real-robot user-study protocol (methods
-//!   in counterbalanced order, per-plate results, mean ± standard error);
+//! - `user_study`: the paper's real-robot user-study protocol (methods
+//!   in counterbalanced order, per-plate results, mean ± standard error),
+//!   in the MuJoCo scene, so only with the crate feature `physics` (run
+//!   `scripts/setup-mujoco` first);
 //! - [`results`]: selection and aggregation; [`report`]: Markdown tables
 //!   beside the paper's published numbers ([`published`], read from data
 //!   files); [`plot`]: SVG figures; [`output`]: writes them all.
@@ -29,8 +31,10 @@ pub mod published;
 pub mod report;
 pub mod results;
 pub mod testbed;
+#[cfg(feature = "physics")]
 pub mod user_study;
 
 pub use method::Method;
 pub use testbed::{NamedModel, Protocol, ProtocolSettings};
+#[cfg(feature = "physics")]
 pub use user_study::{UserStudy, UserStudyConfig, UserStudyResult};

@@ -6,8 +6,12 @@ mod common;
 mod bench;
 mod cli;
 mod data_inputs;
+#[cfg(feature = "physics")]
 mod kinova;
+#[cfg(feature = "physics")]
 mod kinova_seeds;
+#[cfg(not(feature = "physics"))]
+mod without_physics;
 mod reproduce;
 mod resume;
 mod run_reliability;

@@ -18,8 +18,8 @@ struct KinovaFeedingConfig {
 impl EnvironmentConfig for KinovaFeedingConfig {
     fn build(&self, _: &BuildContext) -> Result<Box<dyn Environment>> {
         Err(HilError::unsupported(
-            "kinova_feeding",
-            "simulation",
+            "this build",
+            "the `kinova_feeding` environment",
             crate::ENABLE_PHYSICS,
         ))
     }

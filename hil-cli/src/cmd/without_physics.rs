@@ -27,8 +27,8 @@ pub fn demo(_: DemoArgs) -> Result<()> {
 
 fn unsupported(command: &str) -> HilError {
     HilError::unsupported(
-        command,
-        "the MuJoCo simulation",
+        "this build of hil",
+        format!("`{command}`"),
         hil_kinova_mujoco::ENABLE_PHYSICS,
     )
 }

@@ -32,7 +32,3 @@ pub mod web;
 pub use simulated::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
 pub use terminal::{TerminalChannel, TerminalChannelConfig};
 pub use web::{WebChannel, WebChannelConfig};
-
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}

@@ -39,10 +39,6 @@ pub use demo_plate::{DemoPlate, DemoPlateConfig};
 pub use env::{DatasetReplayEnv, FoodReplayConfig, OutcomeMode, PretrainReward};
 pub use split::FoodSplit;
 
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}
-
 static BUNDLED: OnceLock<Arc<FoodDataset>> = OnceLock::new();
 
 /// The bundled synthetic dataset (16 foods × 30 images, d = 2048), generated

@@ -5,6 +5,9 @@
 //! user-study protocol, aggregation with uncertainty, tables and figures, and
 //! the paper's published tables as data.
 //!
+//! - [`builtin`]: every built-in component type is linked into any
+//!   program using this crate; [`load_experiment`] reads a config with
+//!   all of them, with no registration call;
 //! - [`method`]: a method of either protocol (a labelled policy config,
 //!   built-in or plugin, with an optional tuned hyperparameter);
 //! - [`testbed`]: the paper's simulated-testbed protocol (methods as policy
@@ -22,6 +25,7 @@
 //! published figures**: they are not the paper's results, and every table and
 //! figure says so.
 
+pub mod builtin;
 pub mod calibrate;
 pub mod claims;
 pub mod method;
@@ -34,6 +38,7 @@ pub mod testbed;
 #[cfg(feature = "physics")]
 pub mod user_study;
 
+pub use builtin::{load_experiment, parse_experiment};
 pub use method::Method;
 pub use testbed::{NamedModel, Protocol, ProtocolSettings};
 #[cfg(feature = "physics")]

@@ -65,7 +65,3 @@ pub const PHYSICS: bool = cfg!(feature = "physics");
 /// How to get a build with the MuJoCo simulation: what a program built
 /// without the `physics` feature tells its user.
 pub const ENABLE_PHYSICS: &str = "it was built without the MuJoCo physics; run scripts/setup-mujoco, then build with `--features physics` (bash scripts/hil and scripts/test do both)";
-
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}

@@ -51,7 +51,3 @@ pub use exp_decay::{
 pub use linucb::{LinUcb, LinUcbConfig, LinUcbFields, LinUcbParams};
 pub use policy::{LinearPolicy, QueryRule, RuleContext};
 pub use qg::{LinUcbQg, LinUcbQgConfig, LinUcbQgFields, LinUcbQgParams, QueryGap, query_gap};
-
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}

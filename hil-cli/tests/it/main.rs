@@ -10,11 +10,11 @@ mod data_inputs;
 mod kinova;
 #[cfg(feature = "physics")]
 mod kinova_seeds;
-#[cfg(not(feature = "physics"))]
-mod without_physics;
 mod reproduce;
 mod resume;
 mod run_reliability;
 mod study_resume;
 mod terminal_pty;
 mod web_run;
+#[cfg(not(feature = "physics"))]
+mod without_physics;

@@ -64,7 +64,7 @@ pub use abi::{
     ABI_VERSION, BuildFacts, DECLARATION_SYMBOL, FIXED_STR_LEN, FixedStr, MAGIC, PluginDeclaration,
     PluginHeader, RegisterFn, interface_layout,
 };
-pub use config::{KindOf, PluginComponent, component, optional_component};
+pub use config::{KindOf, PluginComponent, builtin_types, component, optional_component};
 pub use guard::{
     DropPanicSink, Guarded, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload,
     report_drop_panic, take_destructor_panics,

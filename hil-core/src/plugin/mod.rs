@@ -81,6 +81,7 @@ pub use registry::{
 #[doc(hidden)]
 pub use registrar::run_register as __run_register;
 
+#[cfg(feature = "testing")]
 pub(crate) use guard::panic_message;
 
 use std::path::Path;

@@ -29,6 +29,15 @@ pub mod study;
 pub mod terminal;
 pub mod web;
 
+// The HTTP server's unit tests (web::http) use the integration tests'
+// helpers, which name this crate by its name.
+#[cfg(test)]
+extern crate self as hil_channels;
+#[cfg(test)]
+#[allow(dead_code)]
+#[path = "../tests/it/web_support/mod.rs"]
+mod web_support;
+
 pub use simulated::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
 pub use terminal::{TerminalChannel, TerminalChannelConfig};
 pub use web::{WebChannel, WebChannelConfig};

@@ -2,7 +2,7 @@
 //! phone or tablet next to the robot, by touch, keyboard or single switch.
 
 use hil_core::TaskContext;
-pub mod http;
+pub(crate) mod http;
 pub mod urls;
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};

@@ -7,10 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
-use hil_core::HilError;
-use hil_core::testing::mutate::mutated;
 use crate::dataset::FoodDataset;
 use crate::npy::{NpyArray, read_npy_bytes, write_npy, write_npy_bytes};
+use hil_core::HilError;
+use hil_core::testing::mutate::mutated;
 use proptest::prelude::*;
 
 /// The file an error names, whatever its kind.

@@ -89,7 +89,10 @@ fn loader_errors_name_file_record_and_field() {
         )
         .unwrap();
     });
-    assert!(matches!(e, HilError::Data { ref field, .. } if field == "contexts"), "{e:?}");
+    assert!(
+        matches!(e, HilError::Data { ref field, .. } if field == "contexts"),
+        "{e:?}"
+    );
     assert_at(&e, "apple/contexts.npy", None);
 
     // A setting index past the manifest's settings: its row.
@@ -117,6 +120,9 @@ fn loader_errors_name_file_record_and_field() {
             a.data.truncate(a.data.len() - 6);
         })
     });
-    assert!(matches!(e, HilError::Data { ref field, .. } if field == "success"), "{e:?}");
+    assert!(
+        matches!(e, HilError::Data { ref field, .. } if field == "success"),
+        "{e:?}"
+    );
     assert_at(&e, "banana/success.npy", None);
 }

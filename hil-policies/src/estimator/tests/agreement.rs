@@ -2,9 +2,9 @@
 //! relative, through pretraining, online updates, crossovers, duplicates
 //! and checkpoints.
 
+use crate::estimator::reference::NaiveArms;
+use crate::{EstimatorOptions, LinearArms, Representation, RepresentationChoice};
 use hil_core::{ArmId, Context, LabelledObservation};
-use hil_policies::estimator::reference::NaiveArms;
-use hil_policies::{EstimatorOptions, LinearArms, Representation, RepresentationChoice};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -2,18 +2,24 @@
 //!
 //! A Kinova Gen3 feeding environment simulated in MuJoCo 3.17.
 //!
-//! - [`model`]: our own MJCF of the Gen3 6-DoF arm with the 2-DoF feeding
-//!   fork (pitch β, roll γ, four tines), a table, a plate and food items.
-//! - [`food`]: food kinds, randomised mechanical properties, published rates.
-//! - [`skewer`]: the tine–food interaction model (indentation, puncture,
-//!   cutting, grip, tearing) from which skewering success emerges.
-//! - [`controller`]: differential inverse kinematics and the six skewering
-//!   actions (VS/TV/TA × roll 0°/90°).
-//! - [`sim`]: one simulated attempt from placement to hold.
-//! - [`perception`]: what a camera reports and its embedding into contexts.
-//! - [`env`]: [`KinovaFeedingEnv`], the `hil_core::Environment`, and its
-//!   config type `kinova_feeding`.
-//! - [`calibrate`]: success rates per (food, action) beside the published ones.
+//! The public interface is the environment and the tools around it:
+//!
+//! - [`KinovaFeedingEnv`], the `hil_core::Environment`, and its config
+//!   type `kinova_feeding` ([`KinovaFeedingConfig`]);
+//! - [`calibrate`] / [`calibrate_with`]: success rates per (food, action)
+//!   beside the published ones;
+//! - [`Simulator`]: one simulated attempt from placement to hold
+//!   ([`Placement`], [`PerceivedTarget`], [`AttemptReport`]), on our own
+//!   MJCF of the Gen3 6-DoF arm with the 2-DoF feeding fork or on a scene
+//!   given as [`MjcfSource`];
+//! - the six skewering actions ([`ACTIONS`]), food kinds and placement
+//!   settings ([`FoodKind`], [`Setting`]);
+//! - [`KeyframeWriter`] / [`RenderingEnv`]: PNG keyframes of attempts.
+//!
+//! Inside (private): the MJCF model, the tine–food interaction model
+//! (indentation, puncture, cutting, grip, tearing) from which skewering
+//! success emerges, differential inverse kinematics, and simulated
+//! perception with its embedding into contexts.
 //!
 //! Everything above needs the crate feature `physics`, which links
 //! libmujoco: run `scripts/setup-mujoco` once to install MuJoCo into
@@ -23,41 +29,47 @@
 //! `cargo test --workspace` passes with only the Rust toolchain.
 
 #[cfg(feature = "physics")]
-pub mod calibrate;
+mod calibrate;
 #[cfg(feature = "physics")]
-pub mod controller;
+mod controller;
 #[cfg(feature = "physics")]
-pub mod env;
+mod env;
 #[cfg(feature = "physics")]
-pub mod error;
+mod error;
 #[cfg(feature = "physics")]
-pub mod food;
+mod food;
 #[cfg(feature = "physics")]
-pub mod model;
+mod model;
 #[cfg(feature = "physics")]
-pub mod perception;
+mod perception;
 #[cfg(feature = "physics")]
-pub mod render;
+mod render;
 #[cfg(feature = "physics")]
-pub mod sim;
+mod sim;
 #[cfg(feature = "physics")]
-pub mod skewer;
+mod skewer;
 #[cfg(not(feature = "physics"))]
 mod without_physics;
 
 #[cfg(feature = "physics")]
-pub use controller::{ACTIONS, Action};
-
+pub use calibrate::{
+    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow, SettingCell, calibrate,
+    calibrate_with,
+};
 #[cfg(feature = "physics")]
-pub use calibrate::{CalibrationOptions, CalibrationReport, CalibrationRow, calibrate};
+pub use controller::{ACTIONS, Action, RollBy};
 #[cfg(feature = "physics")]
-pub use env::{KinovaFeedingConfig, KinovaFeedingEnv};
+pub use env::{KinovaFeedingConfig, KinovaFeedingEnv, MAX_CONTEXT_DIM, MAX_PRETRAINING_TRIALS};
 #[cfg(feature = "physics")]
 pub use error::KinovaError;
 #[cfg(feature = "physics")]
-pub use food::{FoodKind, FoodModel, FoodProps, Setting, Shape};
+pub use food::{FoodKind, FoodModel, FoodProps, Label, Setting, Shape, parse_labels};
 #[cfg(feature = "physics")]
-pub use sim::{AttemptReport, Simulator};
+pub use model::MjcfSource;
+#[cfg(feature = "physics")]
+pub use render::{Keyframe, KeyframeRecorder, KeyframeWriter, RenderingEnv};
+#[cfg(feature = "physics")]
+pub use sim::{AttemptReport, PUBLISHED_HOLD, PerceivedTarget, Placement, Simulator, StopReason};
 
 /// Whether this build has the MuJoCo simulation (the `physics` feature).
 pub const PHYSICS: bool = cfg!(feature = "physics");

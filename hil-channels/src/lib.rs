@@ -34,7 +34,6 @@ pub mod web;
 #[cfg(test)]
 extern crate self as hil_channels;
 #[cfg(test)]
-#[allow(dead_code)]
 #[path = "../tests/it/web_support/mod.rs"]
 mod web_support;
 

@@ -6,6 +6,10 @@
 
 fn main() {
     println!("cargo::rerun-if-env-changed=MUJOCO_DYNAMIC_LINK_DIR");
+    // Without the `physics` feature nothing links MuJoCo.
+    if std::env::var_os("CARGO_FEATURE_PHYSICS").is_none() {
+        return;
+    }
     if let Ok(dir) = std::env::var("MUJOCO_DYNAMIC_LINK_DIR") {
         println!("cargo::rustc-link-arg=-Wl,-rpath,{dir}");
     }

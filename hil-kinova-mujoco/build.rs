@@ -7,6 +7,10 @@ use std::path::Path;
 
 fn main() {
     println!("cargo::rerun-if-env-changed=MUJOCO_DYNAMIC_LINK_DIR");
+    // Without the `physics` feature nothing links MuJoCo.
+    if std::env::var_os("CARGO_FEATURE_PHYSICS").is_none() {
+        return;
+    }
     let Ok(dir) = std::env::var("MUJOCO_DYNAMIC_LINK_DIR") else {
         println!(
             "cargo::warning=MUJOCO_DYNAMIC_LINK_DIR is not set; run scripts/setup-mujoco and build from the repository"

@@ -29,10 +29,14 @@ pub mod study;
 pub mod terminal;
 pub mod web;
 
+// The HTTP server's unit tests (web::http) use the integration tests'
+// helpers, which name this crate by its name.
+#[cfg(test)]
+extern crate self as hil_channels;
+#[cfg(test)]
+#[path = "../tests/it/web_support/mod.rs"]
+mod web_support;
+
 pub use simulated::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
 pub use terminal::{TerminalChannel, TerminalChannelConfig};
 pub use web::{WebChannel, WebChannelConfig};
-
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}

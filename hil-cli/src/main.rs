@@ -41,13 +41,8 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    // Keep the built-in component crates linked so their typetag
-    // registrations are present in the binary.
-    hil_policies::link();
-    hil_workload::link();
-    hil_envs::link();
-    hil_kinova_mujoco::link();
-    hil_channels::link();
+    // Every built-in component type is registered: this binary uses
+    // hil_experiments, which links them all (hil_experiments::builtin).
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),

@@ -24,7 +24,13 @@
 //! ```
 //!
 //! Crates register built-in types with `#[typetag::serde(name = "...")]` on
-//! an `impl PolicyConfig for ...` (or the other three config traits).
+//! an `impl PolicyConfig for ...` (or the other three config traits). A
+//! program holds the types of the crates linked into it, with no call to
+//! make: `hil_experiments` links every built-in crate, so a program that
+//! reads configs through `hil_experiments::load_experiment` (or uses that
+//! crate at all) knows every built-in type. The names a program holds are
+//! [`crate::plugin::builtin_types`]; a plugin cannot take one of them, and
+//! an unknown `type` is answered with the closest built-in and plugin names.
 //!
 //! [`ExperimentConfig::parse`] checks the whole file before anything is
 //! built: every count against the limits stated in [`limits`], and every

@@ -105,6 +105,19 @@ pub enum HilError {
         /// What is wrong.
         why: String,
     },
+    /// The implementation does not offer this operation at all (e.g. a
+    /// policy that cannot checkpoint, or a build of `hil` without the
+    /// MuJoCo physics), as opposed to refusing it in its current state
+    /// ([`HilError::State`]). Callers may skip what is unsupported.
+    #[error("{component} does not support {operation}: {why}")]
+    Unsupported {
+        /// The component (or program) asked.
+        component: String,
+        /// What it was asked to do.
+        operation: String,
+        /// Why not, and what to use or do instead.
+        why: String,
+    },
     /// A human (or channel) failed in a way the session cannot recover from.
     #[error("query channel `{channel}` failed: {why}")]
     Channel {
@@ -185,6 +198,25 @@ impl HilError {
     pub fn state(component: impl Into<String>, why: impl Into<String>) -> Self {
         Self::State {
             component: component.into(),
+            why: why.into(),
+        }
+    }
+
+    /// Shorthand for [`HilError::Unsupported`].
+    ///
+    /// ```
+    /// use hil_core::HilError;
+    /// let e = HilError::unsupported("my_policy", "checkpoints", "it keeps no state worth saving");
+    /// assert!(matches!(e, HilError::Unsupported { .. }));
+    /// ```
+    pub fn unsupported(
+        component: impl Into<String>,
+        operation: impl Into<String>,
+        why: impl Into<String>,
+    ) -> Self {
+        Self::Unsupported {
+            component: component.into(),
+            operation: operation.into(),
             why: why.into(),
         }
     }

@@ -138,19 +138,24 @@ pub trait Policy: Send {
     fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()>;
 
     /// Serialises the full learning state (estimates, RNG state, counters).
+    /// A policy that cannot checkpoint keeps this default, which returns
+    /// [`HilError::Unsupported`] (the conformance suite then skips its
+    /// checkpoint check).
     fn save(&self) -> Result<Value> {
-        Err(HilError::state(
+        Err(HilError::unsupported(
             self.name(),
-            "this policy cannot checkpoint its state",
+            "checkpoints",
+            "this policy does not implement save()",
         ))
     }
 
     /// Restores a state produced by [`Policy::save`] on a policy of the same type.
     fn restore(&mut self, state: Value) -> Result<()> {
         let _ = state;
-        Err(HilError::state(
+        Err(HilError::unsupported(
             self.name(),
-            "this policy cannot restore a checkpoint",
+            "checkpoints",
+            "this policy does not implement restore()",
         ))
     }
 }

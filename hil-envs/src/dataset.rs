@@ -3,7 +3,7 @@
 //! # Format
 //!
 //! A dataset is a directory holding a manifest `dataset.toml` and NumPy
-//! `.npy` arrays (read by [`crate::npy`]; write them from Python with
+//! `.npy` arrays (read by the crate's own `.npy` reader; write them from Python with
 //! `np.save`):
 //!
 //! ```toml

@@ -110,6 +110,23 @@ pub struct Generated {
     pub readout: Vec<Vec<f64>>,
 }
 
+impl Generated {
+    /// Writes the dataset into `dir` in the documented format
+    /// (`dataset.toml` and its `.npy` arrays, see [`FoodDataset::save`])
+    /// and its readout as `readout.npy` (actions × d); returns the
+    /// manifest's path.
+    pub fn save(&self, dir: &std::path::Path) -> Result<std::path::PathBuf> {
+        let manifest = self.dataset.save(dir)?;
+        let d = self.readout.first().map_or(0, Vec::len);
+        let readout = crate::npy::NpyArray::new(
+            vec![self.readout.len(), d],
+            self.readout.iter().flatten().copied().collect(),
+        )?;
+        crate::npy::write_npy(&dir.join("readout.npy"), &readout)?;
+        Ok(manifest)
+    }
+}
+
 impl SyntheticFoods {
     /// Checks the parameters.
     pub fn validate(&self) -> Result<()> {

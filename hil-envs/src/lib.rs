@@ -3,7 +3,8 @@
 //! The paper's simulated testbed for human-in-the-loop bite acquisition:
 //!
 //! - [`dataset`]: the food dataset format (a TOML manifest plus NumPy `.npy`
-//!   arrays), its validating loader and writer; [`npy`]: the `.npy` codec;
+//!   arrays), its validating loader and writer (the `.npy` codec is
+//!   private to it);
 //! - [`feeding`]: the feeding task's vocabulary and facts, defined once as
 //!   data (actions, placement settings, foods with descriptions, published
 //!   per-food success rates), shared by every crate that needs them;
@@ -28,9 +29,11 @@ pub mod demo_plate;
 pub mod env;
 pub mod feeding;
 pub mod generate;
-pub mod npy;
+mod npy;
 pub mod rates;
 pub mod split;
+#[cfg(test)]
+mod tests;
 
 use std::sync::{Arc, OnceLock};
 
@@ -38,10 +41,6 @@ pub use dataset::{Food, FoodDataset, FoodImage};
 pub use demo_plate::{DemoPlate, DemoPlateConfig};
 pub use env::{DatasetReplayEnv, FoodReplayConfig, OutcomeMode, PretrainReward};
 pub use split::FoodSplit;
-
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}
 
 static BUNDLED: OnceLock<Arc<FoodDataset>> = OnceLock::new();
 

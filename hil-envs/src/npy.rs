@@ -14,13 +14,8 @@
 //! Every error is a [`HilError::Data`] naming the file and the header field
 //! (`magic`, `version`, `header`, `descr`, `fortran_order`, `shape`, `data`).
 //!
-//! ```
-//! use hil_envs::npy::{NpyArray, read_npy_bytes, write_npy_bytes};
-//! let a = NpyArray::new(vec![2, 3], vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]).unwrap();
-//! let bytes = write_npy_bytes(&a);
-//! let back = read_npy_bytes(&bytes, std::path::Path::new("mem.npy")).unwrap();
-//! assert_eq!(back, a);
-//! ```
+//! Private to the crate: the dataset format ([`crate::dataset`]) is the
+//! public interface to these files.
 
 use std::path::Path;
 

@@ -5,13 +5,18 @@
 //! user-study protocol, aggregation with uncertainty, tables and figures, and
 //! the paper's published tables as data.
 //!
+//! - [`builtin`]: every built-in component type is linked into any
+//!   program using this crate; [`load_experiment`] reads a config with
+//!   all of them, with no registration call;
 //! - [`method`]: a method of either protocol (a labelled policy config,
 //!   built-in or plugin, with an optional tuned hyperparameter);
 //! - [`testbed`]: the paper's simulated-testbed protocol (methods as policy
 //!   configs, runs in parallel, hyperparameters chosen on validation, the
 //!   cross-data experiment);
-//! - [`user_study`]: the paper's real-robot user-study protocol (methods
-//!   in counterbalanced order, per-plate results, mean ± standard error);
+//! - `user_study`: the paper's real-robot user-study protocol (methods
+//!   in counterbalanced order, per-plate results, mean ± standard error),
+//!   in the MuJoCo scene, so only with the crate feature `physics` (run
+//!   `scripts/setup-mujoco` first);
 //! - [`results`]: selection and aggregation; [`report`]: Markdown tables
 //!   beside the paper's published numbers ([`published`], read from data
 //!   files); [`plot`]: SVG figures; [`output`]: writes them all.
@@ -20,6 +25,7 @@
 //! published figures**: they are not the paper's results, and every table and
 //! figure says so.
 
+pub mod builtin;
 pub mod calibrate;
 pub mod claims;
 pub mod method;
@@ -29,8 +35,11 @@ pub mod published;
 pub mod report;
 pub mod results;
 pub mod testbed;
+#[cfg(feature = "physics")]
 pub mod user_study;
 
+pub use builtin::{load_experiment, parse_experiment};
 pub use method::Method;
 pub use testbed::{NamedModel, Protocol, ProtocolSettings};
+#[cfg(feature = "physics")]
 pub use user_study::{UserStudy, UserStudyConfig, UserStudyResult};

@@ -1,15 +1,15 @@
 //! The paper's simulated-testbed protocol.
 //!
 //! 1. Split the foods (pretrain / validation / test, [`FoodSplit`]). Every
-//!    policy is built through its [`PolicyConfig`] with a [`BuildContext`]
+//!    policy is built through its [`PolicyConfig`](hil_core::config::PolicyConfig) with a [`BuildContext`]
 //!    that offers the pretraining foods' (context, arm, reward) data, so a
 //!    config with `pretrain = true` starts from the pretrained estimator.
 //! 2. Run every (phase, method, grid value, seed[, policy seed][, deciding
 //!    workload model]) episode once, in parallel. What a method needs comes
 //!    from its config: one that does not read the workload forecast
-//!    ([`PolicyConfig::uses_workload_forecast`]) runs once and is scored under
+//!    ([`PolicyConfig::uses_workload_forecast`](hil_core::config::PolicyConfig::uses_workload_forecast)) runs once and is scored under
 //!    every model; one that does runs once per deciding model; a stochastic
-//!    one ([`PolicyConfig::is_stochastic`]) runs under `n_policy_seeds`
+//!    one ([`PolicyConfig::is_stochastic`](hil_core::config::PolicyConfig::is_stochastic)) runs under `n_policy_seeds`
 //!    policy seeds. w_task never changes a run, only how it is scored.
 //! 3. For every scoring model and w_task, choose each tuned method's
 //!    hyperparameter maximising the mean M_wt over the validation runs,

@@ -11,7 +11,7 @@
 //! `cargo bench -p hil-kinova-mujoco --bench attempt`
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use hil_kinova_mujoco::calibrate::{CalibrationOptions, CalibrationReport, calibrate_with};
+use hil_kinova_mujoco::{CalibrationOptions, CalibrationReport, calibrate_with};
 
 fn opts() -> CalibrationOptions {
     CalibrationOptions {

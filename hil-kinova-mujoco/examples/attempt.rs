@@ -1,9 +1,7 @@
 //! Runs one attempt of every action on every food and prints the reports.
 //!
 //! `cargo run -p hil-kinova-mujoco --example attempt`
-use hil_kinova_mujoco::ACTIONS;
-use hil_kinova_mujoco::food::{FoodKind, FoodModel};
-use hil_kinova_mujoco::sim::{PerceivedTarget, Placement, Simulator};
+use hil_kinova_mujoco::{ACTIONS, FoodKind, FoodModel, PerceivedTarget, Placement, Simulator};
 use rand::SeedableRng;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

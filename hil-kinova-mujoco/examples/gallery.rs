@@ -6,9 +6,10 @@
 //!
 //! `cargo run --release -p hil-kinova-mujoco --features render --example gallery -- hil-kinova-mujoco/docs`
 use hil_core::{ArmId, Environment};
-use hil_kinova_mujoco::ACTIONS;
-use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv, View};
-use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
+use hil_kinova_mujoco::{
+    ACTIONS, KeyframeRecorder, KeyframeWriter, KinovaFeedingConfig, KinovaFeedingEnv, RenderingEnv,
+    View,
+};
 
 /// Master seed of every attempt (the item's size and yaw, perception noise).
 const SEED: u64 = 3;

@@ -4,9 +4,7 @@
 //! along the tines during the hold.
 //!
 //! `cargo run --release -p hil-kinova-mujoco --example hold -- [trials] [hold_s] [free_step_s]`
-use hil_kinova_mujoco::ACTIONS;
-use hil_kinova_mujoco::food::{FoodKind, FoodModel};
-use hil_kinova_mujoco::sim::{PerceivedTarget, Placement, Simulator};
+use hil_kinova_mujoco::{ACTIONS, FoodKind, FoodModel, PerceivedTarget, Placement, Simulator};
 use rand::SeedableRng;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -1,8 +1,9 @@
 //! Renders the keyframes of one attempt:
 //! `cargo run -p hil-kinova-mujoco --features render --example render -- out/frames`
 use hil_core::{ArmId, Environment};
-use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
-use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
+use hil_kinova_mujoco::{
+    KeyframeRecorder, KeyframeWriter, KinovaFeedingConfig, KinovaFeedingEnv, RenderingEnv,
+};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = std::env::args()

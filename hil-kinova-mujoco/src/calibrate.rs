@@ -9,7 +9,7 @@
 //! result does not depend on the number of threads.
 //!
 //! ```
-//! use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
+//! use hil_kinova_mujoco::{CalibrationOptions, calibrate_with};
 //! use hil_kinova_mujoco::{FoodKind, Setting};
 //!
 //! let opts = CalibrationOptions {

@@ -247,7 +247,7 @@ pub fn parse_label<T: Label>(s: &str) -> Option<T> {
 /// list or an unknown label is an error naming the field and the choices.
 ///
 /// ```
-/// use hil_kinova_mujoco::food::{FoodKind, parse_labels};
+/// use hil_kinova_mujoco::{FoodKind, parse_labels};
 ///
 /// let foods: Vec<FoodKind> = parse_labels("plate", &["carrot".into()])?;
 /// assert_eq!(foods, [FoodKind::Carrot]);

@@ -2,40 +2,85 @@
 //!
 //! A Kinova Gen3 feeding environment simulated in MuJoCo 3.17.
 //!
-//! - [`model`]: our own MJCF of the Gen3 6-DoF arm with the 2-DoF feeding
-//!   fork (pitch β, roll γ, four tines), a table, a plate and food items.
-//! - [`food`]: food kinds, randomised mechanical properties, published rates.
-//! - [`skewer`]: the tine–food interaction model (indentation, puncture,
-//!   cutting, grip, tearing) from which skewering success emerges.
-//! - [`controller`]: differential inverse kinematics and the six skewering
-//!   actions (VS/TV/TA × roll 0°/90°).
-//! - [`sim`]: one simulated attempt from placement to hold.
-//! - [`perception`]: what a camera reports and its embedding into contexts.
-//! - [`env`]: [`KinovaFeedingEnv`], the `hil_core::Environment`, and its
-//!   config type `kinova_feeding`.
-//! - [`calibrate`]: success rates per (food, action) beside the published ones.
+//! The public interface is the environment and the tools around it:
 //!
-//! Run `scripts/setup-mujoco` once to install MuJoCo into `third_party/`.
+//! - [`KinovaFeedingEnv`], the `hil_core::Environment`, and its config
+//!   type `kinova_feeding` ([`KinovaFeedingConfig`]);
+//! - [`calibrate`] / [`calibrate_with`]: success rates per (food, action)
+//!   beside the published ones;
+//! - [`Simulator`]: one simulated attempt from placement to hold
+//!   ([`Placement`], [`PerceivedTarget`], [`AttemptReport`]), on our own
+//!   MJCF of the Gen3 6-DoF arm with the 2-DoF feeding fork or on a scene
+//!   given as [`MjcfSource`];
+//! - the six skewering actions ([`ACTIONS`]), food kinds and placement
+//!   settings ([`FoodKind`], [`Setting`]);
+//! - [`KeyframeWriter`] / [`RenderingEnv`]: PNG keyframes of attempts.
+//!
+//! Inside (private): the MJCF model, the tine–food interaction model
+//! (indentation, puncture, cutting, grip, tearing) from which skewering
+//! success emerges, differential inverse kinematics, and simulated
+//! perception with its embedding into contexts.
+//!
+//! Everything above needs the crate feature `physics`, which links
+//! libmujoco: run `scripts/setup-mujoco` once to install MuJoCo into
+//! `third_party/`, then build with `--features physics`. Without the
+//! feature the crate only registers a `kinova_feeding` config whose build
+//! fails with [`hil_core::HilError::Unsupported`] saying so, so that
+//! `cargo test --workspace` passes with only the Rust toolchain.
 
-pub mod calibrate;
-pub mod controller;
-pub mod env;
-pub mod error;
-pub mod food;
-pub mod model;
-pub mod perception;
-pub mod render;
-pub mod sim;
-pub mod skewer;
+#[cfg(feature = "physics")]
+mod calibrate;
+#[cfg(feature = "physics")]
+mod controller;
+#[cfg(feature = "physics")]
+mod env;
+#[cfg(feature = "physics")]
+mod error;
+#[cfg(feature = "physics")]
+mod food;
+#[cfg(feature = "physics")]
+mod model;
+#[cfg(feature = "physics")]
+mod perception;
+#[cfg(feature = "physics")]
+mod render;
+#[cfg(feature = "physics")]
+mod sim;
+#[cfg(feature = "physics")]
+mod skewer;
+#[cfg(not(feature = "physics"))]
+mod without_physics;
 
-pub use controller::{ACTIONS, Action};
-
-pub use calibrate::{CalibrationOptions, CalibrationReport, CalibrationRow, calibrate};
-pub use env::{KinovaFeedingConfig, KinovaFeedingEnv};
+#[cfg(feature = "physics")]
+pub use calibrate::{
+    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow, SettingCell, calibrate,
+    calibrate_with,
+};
+#[cfg(feature = "physics")]
+pub use controller::{ACTIONS, Action, RollBy};
+#[cfg(feature = "physics")]
+pub use env::{
+    KinovaFeedingConfig, KinovaFeedingEnv, MAX_CONTEXT_DIM, MAX_PRETRAINING_TRIALS,
+    simulated_pretraining,
+};
+#[cfg(feature = "physics")]
 pub use error::KinovaError;
-pub use food::{FoodKind, FoodModel, FoodProps, Setting, Shape};
-pub use sim::{AttemptReport, Simulator};
+#[cfg(feature = "physics")]
+pub use food::{FoodKind, FoodModel, FoodProps, Label, Setting, Shape, parse_labels};
+#[cfg(feature = "physics")]
+pub use model::MjcfSource;
+#[cfg(feature = "physics")]
+pub use render::{Keyframe, KeyframeRecorder, KeyframeWriter, RenderingEnv, View};
+#[cfg(feature = "physics")]
+pub use sim::{
+    AttemptReport, FREE_DT, PUBLISHED_HOLD, PerceivedTarget, Placement, Simulator, StopReason,
+};
+#[cfg(feature = "physics")]
+pub use skewer::{MAX_DT, REF_DT};
 
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}
+/// Whether this build has the MuJoCo simulation (the `physics` feature).
+pub const PHYSICS: bool = cfg!(feature = "physics");
+
+/// How to get a build with the MuJoCo simulation: what a program built
+/// without the `physics` feature tells its user.
+pub const ENABLE_PHYSICS: &str = "it was built without the MuJoCo physics; run scripts/setup-mujoco, then build with `--features physics` (bash scripts/hil and scripts/test do both)";

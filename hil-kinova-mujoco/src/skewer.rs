@@ -169,6 +169,7 @@ impl SkewerModel {
     }
 
     /// The tines' states.
+    #[cfg(test)]
     pub fn tines(&self) -> &[TineState; N_TINES] {
         &self.tines
     }

@@ -33,7 +33,7 @@ mod always_query;
 mod common;
 mod config;
 pub mod demo_learner;
-pub mod estimator;
+mod estimator;
 mod exp_decay;
 mod linucb;
 mod params;
@@ -43,7 +43,8 @@ mod qg;
 pub use always_query::{AlwaysQuery, AlwaysQueryConfig, AlwaysQueryFields, AlwaysQueryParams};
 pub use config::{EstimatorConfig, LinearPolicyConfig, POLICY_TYPES, RuleConfig, example_fields};
 pub use estimator::{
-    ArmEstimate, EstimatorOptions, LinearArms, Representation, RepresentationChoice,
+    ArmEstimate, DEFAULT_CROSSOVER, EstimatorOptions, LinearArms, Representation,
+    RepresentationChoice,
 };
 pub use exp_decay::{
     ExpDecayRng, LinUcbExpDecay, LinUcbExpDecayConfig, LinUcbExpDecayFields, LinUcbExpDecayParams,
@@ -51,7 +52,3 @@ pub use exp_decay::{
 pub use linucb::{LinUcb, LinUcbConfig, LinUcbFields, LinUcbParams};
 pub use policy::{LinearPolicy, QueryRule, RuleContext};
 pub use qg::{LinUcbQg, LinUcbQgConfig, LinUcbQgFields, LinUcbQgParams, QueryGap, query_gap};
-
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}

@@ -916,11 +916,6 @@ fn study_fit_json(
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    // Keep the crates whose components configs name (typetag) linked.
-    hil_envs::link();
-    hil_channels::link();
-    hil_policies::link();
-    hil_workload::link();
     m.add_class::<GymCore>()?;
     m.add_class::<NativePolicy>()?;
     m.add_function(wrap_pyfunction!(paper_food_split_json, m)?)?;

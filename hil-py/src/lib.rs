@@ -32,20 +32,11 @@ mod workload;
 /// The native module. The Python package re-exports its public names.
 #[pymodule]
 fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    // Keep the built-in component crates (and their typetag registrations)
-    // linked: Python names their types only in configs.
-    hil_policies::link();
-    hil_workload::link();
-    hil_envs::link();
-    hil_channels::link();
-    #[cfg(feature = "kinova")]
-    hil_kinova_mujoco::link();
-    // Whether this build has the Kinova environment: whether its config
-    // type parses (nothing is built, MuJoCo is not called).
-    let mut probe = toml::Table::new();
-    probe.insert("type".into(), "kinova_feeding".into());
-    let kinova = components::environment_config(toml::Value::Table(probe)).is_ok();
-    m.add("KINOVA", kinova)?;
+    // Every built-in component type is linked through hil-experiments
+    // (`hil_experiments::builtin`); nothing to call. Whether this build can
+    // run the Kinova environment: the `kinova` feature turns on MuJoCo
+    // physics (without it the type parses but refuses to build).
+    m.add("KINOVA", cfg!(feature = "kinova"))?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The UCB weight α of the paper's methods (hil's choice; the paper does not state it).
     m.add("PAPER_ALPHA", hil_experiments::method::PAPER_ALPHA)?;

@@ -54,7 +54,3 @@ pub use models::{FittedModel, ModelSpec};
 pub fn load_model_json(path: impl AsRef<Path>) -> Result<Arc<dyn WorkloadModel>> {
     Ok(Arc::new(FittedModel::load(path)?))
 }
-
-/// Does nothing; calling it keeps this crate (and its typetag registrations)
-/// linked into a binary that names its components only in configs.
-pub fn link() {}

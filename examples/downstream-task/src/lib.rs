@@ -10,13 +10,13 @@
 //!
 //! Because the crate links hil-core statically, registering the config with
 //! typetag is enough: `type = "cup_handover"` works in any experiment file
-//! of a program that links this crate (call [`link`] from `main` so the
-//! linker keeps it).
+//! of a program that uses this crate (a program that names nothing of it
+//! says `use hil_example_downstream_task as _;`, which links it).
 //!
 //! ```
 //! use hil_core::config::EnvironmentConfig;
 //! use hil_core::BuildContext;
-//! hil_example_downstream_task::link();
+//! use hil_example_downstream_task as _;
 //! let cfg: Box<dyn EnvironmentConfig> = toml::from_str("type = \"cup_handover\"\nhandovers = 4").unwrap();
 //! let env = cfg.build(&BuildContext::new(".", 0)).unwrap();
 //! assert_eq!(env.action_space().len(), 5);
@@ -40,9 +40,6 @@ pub const POSES: [&str; 5] = [
     "high_right",
     "low_right",
 ];
-
-/// Keeps this crate's typetag registration in the final binary.
-pub fn link() {}
 
 /// The environment config, named `cup_handover` in experiment files.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -2,7 +2,7 @@
 //! phone or tablet next to the robot, by touch, keyboard or single switch.
 
 use hil_core::TaskContext;
-pub mod http;
+pub(crate) mod http;
 pub mod urls;
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
@@ -142,7 +142,8 @@ impl Shared {
 ///   gives one URL per address of the machine ([`urls`](Self::urls)).
 /// - Clients without the token cannot lock the person out: each request
 ///   must arrive whole within 10 s, and requests carrying the token have
-///   connection slots of their own (see [`http`]).
+///   connection slots of their own (the server's limits are listed in
+///   `hil-channels/src/web/http/mod.rs`).
 /// - Answers are accepted only from the page's own origin (`Origin` must
 ///   match `Host`, a JSON body is required, `Host` must be an IP address,
 ///   `localhost` or an allowed name), so another web site open in the same

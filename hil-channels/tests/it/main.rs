@@ -9,6 +9,4 @@ mod study_browser;
 mod study_http;
 mod terminal;
 mod web_browser;
-mod web_fuzz;
 mod web_http;
-mod web_slow_clients;

@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use hil_core::HilError;
 use hil_envs::dataset::FoodDataset;
 use hil_envs::generate::SyntheticFoods;
-use hil_envs::npy::{NpyArray, write_npy};
 use hil_envs::rates::PublishedRates;
 
 /// Arguments of `hil data`.
@@ -89,12 +88,7 @@ fn generate(a: GenerateArgs) -> hil_core::Result<()> {
         ));
     }
     let out = g.generate()?;
-    let manifest = out.dataset.save(&a.out)?;
-    let readout = NpyArray::new(
-        vec![out.readout.len(), g.dim],
-        out.readout.iter().flatten().copied().collect(),
-    )?;
-    write_npy(&a.out.join("readout.npy"), &readout)?;
+    let manifest = out.save(&a.out)?;
     let params = toml::to_string_pretty(&g).map_err(|e| HilError::serde("generator", e))?;
     let p = a.out.join("generator.toml");
     std::fs::write(&p, params).map_err(|e| HilError::io("writing", &p, e))?;

@@ -16,11 +16,10 @@ use std::path::{Path, PathBuf};
 
 use hil_core::{HilError, Result};
 use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyResult};
-use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
-use hil_kinova_mujoco::controller::RollBy;
-use hil_kinova_mujoco::food::{FoodKind, Label, parse_labels};
-use hil_kinova_mujoco::render::{KeyframeRecorder, KeyframeWriter, RenderingEnv};
-use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
+use hil_kinova_mujoco::{
+    CalibrationOptions, FoodKind, KeyframeRecorder, KeyframeWriter, KinovaFeedingConfig,
+    KinovaFeedingEnv, Label, RenderingEnv, RollBy, calibrate_with, parse_labels,
+};
 
 /// Arguments of `hil kinova`.
 #[derive(Debug, clap::Args)]

@@ -2,6 +2,11 @@
 
 pub mod bench;
 pub mod data;
+#[cfg(feature = "physics")]
+pub mod kinova;
+// Without MuJoCo, `hil kinova` and `hil demo` only say how to enable them.
+#[cfg(not(feature = "physics"))]
+#[path = "without_physics.rs"]
 pub mod kinova;
 pub mod plugins;
 pub mod reproduce;

@@ -5,9 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use hil_core::record::{Header, RecordLog, run_recorded};
-use hil_core::{
-    EpisodeMetrics, ExperimentConfig, ExperimentSummary, HilError, SessionObserver, StepEvent,
-};
+use hil_core::{EpisodeMetrics, ExperimentSummary, HilError, SessionObserver, StepEvent};
 
 /// Arguments of `hil run`.
 #[derive(Debug, clap::Args)]
@@ -130,7 +128,7 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
     let summary = match start {
         Start::Fresh { config, log } => {
             let text = hil_core::files::read_text(&config, hil_core::files::limits::CONFIG)?;
-            let cfg = ExperimentConfig::parse(&text, &config)?;
+            let cfg = hil_experiments::parse_experiment(&text, &config)?;
             // Absolute, so that a resume from another directory finds the
             // same files; made absolute before taking the directory, which
             // for a bare file name (`exp.toml`) is empty.
@@ -155,7 +153,7 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
         Start::Resume(log_path) => {
             let (log, logged) = RecordLog::open(&log_path)?;
             let header = &logged.header;
-            let cfg = ExperimentConfig::parse(&header.config, &header.config_path)?;
+            let cfg = hil_experiments::parse_experiment(&header.config, &header.config_path)?;
             let mut exp = cfg.build(&header.base_dir)?;
             if !quiet {
                 eprintln!(

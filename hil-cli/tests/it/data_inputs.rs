@@ -12,7 +12,6 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use common::hil;
-use hil_envs::npy::{NpyArray, write_npy};
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hil-data-inputs-{}-{name}", std::process::id()));
@@ -96,39 +95,35 @@ fn dataset_manifest_that_is_not_a_file_is_refused() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A one-food dataset whose `field` array is `array` (others valid).
+/// A small dataset written by `hil data generate`, whose first food's
+/// `field` array is `array` (no field: left valid).
 fn dataset_with(dir: &Path, field: &str, array: &Path) -> PathBuf {
-    let food = dir.join("kiwi");
-    std::fs::create_dir_all(&food).unwrap();
-    write_npy(
-        &food.join("contexts.npy"),
-        &NpyArray::new(vec![2, 3], vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6]).unwrap(),
-    )
-    .unwrap();
-    write_npy(
-        &food.join("success.npy"),
-        &NpyArray::new(vec![2, 2], vec![0.5, 0.25, 1.0, 0.0]).unwrap(),
-    )
-    .unwrap();
-    write_npy(
-        &food.join("settings.npy"),
-        &NpyArray::new(vec![2], vec![0.0, 0.0]).unwrap(),
-    )
-    .unwrap();
-    let path_of = |f: &str| {
-        if f == field {
-            array.display().to_string()
-        } else {
-            format!("kiwi/{f}.npy")
-        }
-    };
-    let manifest = format!(
-        "name = \"t\"\nactions = [\"a\", \"b\"]\nsettings = [\"isolated\"]\ncontext_dim = 3\n\n[[foods]]\nname = \"kiwi\"\ncontexts = \"{}\"\nsuccess = \"{}\"\nsettings = \"{}\"\n",
-        path_of("contexts"),
-        path_of("success"),
-        path_of("settings"),
-    );
-    std::fs::write(dir.join("dataset.toml"), manifest).unwrap();
+    let out = hil(&[
+        "data",
+        "generate",
+        "--out",
+        dir.to_str().unwrap(),
+        "--images-per-setting",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let manifest = dir.join("dataset.toml");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    let prefix = format!("{field} = \"");
+    let mut replaced = field.is_empty();
+    let lines: Vec<String> = text
+        .lines()
+        .map(|l| {
+            if !replaced && l.starts_with(&prefix) {
+                replaced = true;
+                format!("{field} = \"{}\"", array.display())
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    assert!(replaced, "no `{field}` array in {text}");
+    std::fs::write(&manifest, lines.join("\n")).unwrap();
     dir.to_path_buf()
 }
 

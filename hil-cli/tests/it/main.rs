@@ -6,7 +6,9 @@ mod common;
 mod bench;
 mod cli;
 mod data_inputs;
+#[cfg(feature = "physics")]
 mod kinova;
+#[cfg(feature = "physics")]
 mod kinova_seeds;
 mod reproduce;
 mod resume;
@@ -14,3 +16,5 @@ mod run_reliability;
 mod study_resume;
 mod terminal_pty;
 mod web_run;
+#[cfg(not(feature = "physics"))]
+mod without_physics;

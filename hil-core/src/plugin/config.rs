@@ -105,7 +105,8 @@ kind_of!(WorkloadModelConfig, WorkloadModel);
 kind_of!(QueryChannelConfig, QueryChannel);
 
 /// Deserialises a component table: a plugin type if a loaded plugin
-/// registered its `type`, else whatever typetag knows. Use it as
+/// registered its `type`, else a built-in (typetag) type, else an error
+/// listing the closest built-in and plugin names. Use it as
 /// `#[serde(deserialize_with = "hil_core::plugin::component")]` on a
 /// `Box<dyn PolicyConfig>` (or any of the four) field of a config file of
 /// your own, so that plugin types work there as in [`crate::ExperimentConfig`].
@@ -122,29 +123,25 @@ where
         .map(str::to_string);
     if let Some(name) = ty.as_deref()
         && name != "plugin"
-        && registry::is_registered(T::KIND, name)
     {
-        let mut params = match value {
-            toml::Value::Table(t) => t,
-            _ => unreachable!("only tables have a `type` key"),
-        };
-        let name = name_of(&mut params);
-        return Ok(T::from_plugin(PluginComponent { name, params }));
-    }
-    Box::<T>::deserialize(value).map_err(|e| {
-        let msg = e.message().trim().to_string();
-        match (msg.strip_prefix("unknown variant `"), ty.as_deref()) {
-            (Some(_), Some(name)) => {
-                let mut known = builtin_names(T::KIND);
-                known.extend(registry::components(T::KIND).into_iter().map(|c| c.name));
-                D::Error::custom(format!(
-                    "unknown variant `{name}`: {}",
-                    registry::unknown_message(T::KIND, name, &known)
-                ))
-            }
-            _ => D::Error::custom(msg),
+        if registry::is_registered(T::KIND, name) {
+            let mut params = match value {
+                toml::Value::Table(t) => t,
+                _ => unreachable!("only tables have a `type` key"),
+            };
+            let name = name_of(&mut params);
+            return Ok(T::from_plugin(PluginComponent { name, params }));
         }
-    })
+        if !builtin_knows(T::KIND, name) {
+            let mut known = builtin_types(T::KIND);
+            known.extend(registry::components(T::KIND).into_iter().map(|c| c.name));
+            return Err(D::Error::custom(format!(
+                "unknown variant `{name}`: {}",
+                registry::unknown_message(T::KIND, name, &known)
+            )));
+        }
+    }
+    Box::<T>::deserialize(value).map_err(|e| D::Error::custom(e.message().trim()))
 }
 
 /// [`component`] for an optional field.
@@ -164,49 +161,101 @@ fn name_of(table: &mut toml::Table) -> String {
     }
 }
 
-/// The names in serde's "expected one of `a`, `b`" (or "expected `a`").
-fn variants_of(msg: &str) -> Vec<String> {
-    let Some(i) = msg.find("expected ") else {
-        return Vec::new();
-    };
-    msg[i..]
-        .split('`')
-        .skip(1)
-        .step_by(2)
-        .map(str::to_string)
-        .collect()
+/// What typetag answered for a `type` tag, taken from serde's structured
+/// error constructors rather than from message text: typetag reports an
+/// unknown tag through [`serde::de::Error::unknown_variant`], handing over
+/// the names in its own registry.
+#[derive(Debug)]
+enum Probe {
+    /// The tag is not registered; these are the names that are.
+    Unknown(&'static [&'static str]),
+    /// Anything else (the tag is known; its fields were missing).
+    Other,
 }
 
-fn try_builtin(kind: ComponentKind, name: &str) -> std::result::Result<(), String> {
-    let mut t = toml::Table::new();
-    t.insert("type".into(), toml::Value::String(name.to_string()));
-    let v = toml::Value::Table(t);
-    let r = match kind {
-        ComponentKind::Policy => Box::<dyn PolicyConfig>::deserialize(v).map(drop),
-        ComponentKind::Environment => Box::<dyn EnvironmentConfig>::deserialize(v).map(drop),
-        ComponentKind::WorkloadModel => Box::<dyn WorkloadModelConfig>::deserialize(v).map(drop),
-        ComponentKind::QueryChannel => Box::<dyn QueryChannelConfig>::deserialize(v).map(drop),
-    };
-    r.map_err(|e| e.message().to_string())
-}
-
-/// Whether typetag knows a built-in type `name` of `kind`.
-pub(crate) fn builtin_knows(kind: ComponentKind, name: &str) -> bool {
-    match try_builtin(kind, name) {
-        Ok(()) => true,
-        Err(msg) => !msg.starts_with("unknown variant"),
+impl std::fmt::Display for Probe {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("type probe")
     }
 }
 
-/// The built-in (typetag) type names of `kind`.
-pub(crate) fn builtin_names(kind: ComponentKind) -> Vec<String> {
-    // Ask typetag about a name nobody registers: its error lists them all.
-    match try_builtin(kind, "\u{0}") {
-        Ok(()) => Vec::new(),
+impl std::error::Error for Probe {}
+
+impl serde::de::Error for Probe {
+    fn custom<M: std::fmt::Display>(_: M) -> Self {
+        Self::Other
+    }
+    fn unknown_variant(_: &str, expected: &'static [&'static str]) -> Self {
+        Self::Unknown(expected)
+    }
+}
+
+/// Deserialises `{ type = name }` as a config of `kind`: `Some(names)` if
+/// typetag has no such type, with the names it has.
+fn probe(kind: ComponentKind, name: &str) -> Option<&'static [&'static str]> {
+    use serde::de::value::MapDeserializer;
+    let table = || MapDeserializer::<_, Probe>::new(std::iter::once(("type", name)));
+    let r = match kind {
+        ComponentKind::Policy => Box::<dyn PolicyConfig>::deserialize(table()).map(drop),
+        ComponentKind::Environment => Box::<dyn EnvironmentConfig>::deserialize(table()).map(drop),
+        ComponentKind::WorkloadModel => {
+            Box::<dyn WorkloadModelConfig>::deserialize(table()).map(drop)
+        }
+        ComponentKind::QueryChannel => {
+            Box::<dyn QueryChannelConfig>::deserialize(table()).map(drop)
+        }
+    };
+    match r {
+        Err(Probe::Unknown(names)) => Some(names),
+        Ok(()) | Err(Probe::Other) => None,
+    }
+}
+
+/// Whether a built-in (typetag) type `name` of `kind` is linked into this
+/// program.
+pub(crate) fn builtin_knows(kind: ComponentKind, name: &str) -> bool {
+    probe(kind, name).is_none()
+}
+
+/// The built-in (typetag) config type names of `kind` that this program
+/// holds, sorted: those of every crate linked into it (see
+/// `hil_experiments::builtin`), without the explicit form `plugin`.
+///
+/// ```
+/// use hil_core::plugin::{ComponentKind, builtin_types};
+/// // hil-core alone registers no component type of its own.
+/// assert!(builtin_types(ComponentKind::Policy).is_empty());
+/// ```
+pub fn builtin_types(kind: ComponentKind) -> Vec<String> {
+    // A name nobody registers: typetag answers with every name it has.
+    probe(kind, "\u{0}")
+        .unwrap_or_default()
+        .iter()
         // `plugin` is the explicit form, not a type worth suggesting.
-        Err(msg) => variants_of(&msg)
-            .into_iter()
-            .filter(|n| n != "plugin")
-            .collect(),
+        .filter(|n| **n != "plugin")
+        .map(|n| n.to_string())
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn typetag_names_come_through_the_structured_probe() {
+        // hil-core itself registers only `plugin`, for every kind; were
+        // typetag to stop reporting unknown tags through `unknown_variant`,
+        // the probe would find no names and call every name known.
+        for kind in [
+            ComponentKind::Policy,
+            ComponentKind::Environment,
+            ComponentKind::WorkloadModel,
+            ComponentKind::QueryChannel,
+        ] {
+            assert_eq!(probe(kind, "\u{0}"), Some(&["plugin"][..]), "{kind}");
+            assert!(builtin_knows(kind, "plugin"));
+            assert!(!builtin_knows(kind, "no_such_type"));
+            assert!(builtin_types(kind).is_empty());
+        }
     }
 }

@@ -3,7 +3,7 @@
 //!
 //! Rust has no stable ABI, and typetag's registry does not cross a `dlopen`
 //! boundary (each library carries its own copy). So a plugin is a `cdylib`
-//! that exports one [`PluginDeclaration`] made by [`declare_plugin!`]:
+//! that exports one [`PluginDeclaration`] made by [`declare_plugin!`](crate::declare_plugin):
 //!
 //! 1. a header read before anything else is trusted: a magic tag and the
 //!    [`ABI_VERSION`], then the panic strategy, hil-core version, rustc
@@ -18,7 +18,7 @@
 //!
 //! Every factory and every method of every object a plugin returns runs
 //! under a panic guard compiled into the plugin ([`GuardedPolicy`] and
-//! friends), so a panicking plugin yields a [`HilError::Plugin`] and the
+//! friends), so a panicking plugin yields a [`HilError::Plugin`](crate::HilError::Plugin) and the
 //! host carries on. Libraries are never unloaded, so objects never outlive
 //! their code; loading the same library twice is harmless.
 //!
@@ -64,7 +64,7 @@ pub use abi::{
     ABI_VERSION, BuildFacts, DECLARATION_SYMBOL, FIXED_STR_LEN, FixedStr, MAGIC, PluginDeclaration,
     PluginHeader, RegisterFn, interface_layout,
 };
-pub use config::{KindOf, PluginComponent, component, optional_component};
+pub use config::{KindOf, PluginComponent, builtin_types, component, optional_component};
 pub use guard::{
     DropPanicSink, Guarded, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload,
     report_drop_panic, take_destructor_panics,

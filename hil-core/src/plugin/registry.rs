@@ -134,7 +134,7 @@ fn factory(kind: ComponentKind, name: &str) -> Result<(Factory, PathBuf)> {
                 .filter(|(k, _)| *k == kind)
                 .map(|(_, n)| n.clone())
                 .collect();
-            known.extend(super::config::builtin_names(kind));
+            known.extend(super::config::builtin_types(kind));
             Err(HilError::invalid_parameter(
                 "type",
                 name,

@@ -4,7 +4,7 @@
 //! previous line's chain value followed by the line's own content (the
 //! record's JSON without the `chain` field). So a changed byte anywhere,
 //! a removed or reordered line, or a header spliced from another log breaks
-//! the chain at a line that [`ChainCheck`] names.
+//! the chain, and the check names the line at fault.
 //!
 //! `resumed` markers are chained *beside* the log, not into it: their digest
 //! is computed from the chain value before them (so a damaged marker is

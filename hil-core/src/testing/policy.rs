@@ -42,7 +42,7 @@ pub fn check_policy(make: Make<'_>) -> Result<ConformanceReport, ConformanceFail
 /// ([`HilError::ArmOutOfRange`]), [`Check::RejectionHasNoEffect`] (after
 /// the refusals the policy still decides like its untouched twin) and
 /// [`Check::Checkpoint`] (skipped only when a fresh instance's `save`
-/// returns [`HilError::State`], the trait's "cannot checkpoint").
+/// returns [`HilError::Unsupported`], what the trait's default `save` does).
 pub fn check_policy_with(
     make: Make<'_>,
     opts: &CheckOptions,
@@ -199,7 +199,7 @@ fn run(
         let mut a = build(&c)?;
         a.seed(42);
         match a.save() {
-            Err(e @ HilError::State { .. }) => {
+            Err(e @ HilError::Unsupported { .. }) => {
                 c.skip(Check::Checkpoint, e.to_string());
                 return Ok(c.finish());
             }
@@ -207,7 +207,7 @@ fn run(
                 return Err(c.fail(
                     Check::Checkpoint,
                     format!(
-                        "save() on a fresh instance failed: {}; a policy that cannot checkpoint returns HilError::State (the trait's default)",
+                        "save() on a fresh instance failed: {}; a policy that cannot checkpoint returns HilError::Unsupported (the trait's default)",
                         super::describe_error(&e)
                     ),
                 ));

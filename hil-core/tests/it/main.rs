@@ -1,6 +1,7 @@
 //! The integration tests of `hil-core`, linked into one test binary (one
 //! link instead of one per file); each module was a file of its own.
 
+mod checkpoint_unsupported;
 mod config;
 mod conformance_catches;
 mod properties;

@@ -231,13 +231,6 @@ impl UserStudyConfig {
     /// loaded first, so that plugin types are usable wherever built-in ones
     /// are. Every error names the file, line and field.
     pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
-        // typetag finds a built-in type only if its crate is linked into the
-        // program; a program that names them only in files would drop them.
-        hil_policies::link();
-        hil_workload::link();
-        hil_envs::link();
-        hil_kinova_mujoco::link();
-        hil_channels::link();
         load_plugins(text, path)?;
         let cfg: Self = parse_toml(text, path)?;
         cfg.validate_in(text, path)?;

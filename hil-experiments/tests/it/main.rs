@@ -2,6 +2,9 @@
 //! link instead of one per file); each module was a file of its own.
 
 mod testbed;
+#[cfg(feature = "physics")]
 mod user_study;
+#[cfg(feature = "physics")]
 mod user_study_plugins;
+#[cfg(feature = "physics")]
 mod user_study_selection;

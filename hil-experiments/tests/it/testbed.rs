@@ -12,7 +12,6 @@ use hil_experiments::testbed::{CrossSetting, Phase, RunKey, RunRecord};
 use hil_experiments::{NamedModel, Protocol, ProtocolSettings};
 
 fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
-    hil_policies::link();
     let ds = Arc::new(
         SyntheticFoods {
             dim: 224,
@@ -270,7 +269,6 @@ fn the_many_seed_run_contains_the_paper_protocol_run() {
 
 #[test]
 fn paper_protocol_config_file_matches_the_built_in_settings() {
-    hil_policies::link();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/configs/paper-protocol.toml");
     assert_eq!(
@@ -292,9 +290,6 @@ fn a_testbed_episode_and_an_experiment_file_episode_score_alike() {
     // The same episode (same components, same seeds) through the protocol
     // and through an experiment file, as `hil run` builds it: hil-core's one
     // scoring definition gives the same ΔWL and M_wt (and every other figure).
-    hil_policies::link();
-    hil_workload::link();
-    hil_channels::link();
     let dataset = hil_envs::bundled_dataset().unwrap();
     let f2 = hil_workload::bundled::load("f2_sim").unwrap();
     let mut settings = ProtocolSettings::paper();
@@ -373,7 +368,6 @@ type = "simulated_expert"
 
 #[test]
 fn settings_counts_are_bounded_and_located() {
-    hil_policies::link();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/configs/paper-protocol.toml");
     let text = std::fs::read_to_string(&path).unwrap();

@@ -11,11 +11,10 @@ use hil_core::{
     ArmId, Choice, Difficulty, Distraction, Environment, QueryKind, ResponseType, Session,
     SessionSettings,
 };
-use hil_kinova_mujoco::controller::ACTIONS;
-use hil_kinova_mujoco::food::{FoodKind, FoodModel};
-use hil_kinova_mujoco::model::{self, MjcfSource};
-use hil_kinova_mujoco::sim::{PerceivedTarget, Placement, Simulator};
-use hil_kinova_mujoco::{KinovaError, KinovaFeedingConfig, KinovaFeedingEnv};
+use hil_kinova_mujoco::{
+    ACTIONS, FoodKind, FoodModel, KinovaError, KinovaFeedingConfig, KinovaFeedingEnv, MjcfSource,
+    PerceivedTarget, Placement, Simulator,
+};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 
@@ -171,7 +170,7 @@ fn missing_and_malformed_mjcf_files_are_clear_errors() {
     std::fs::create_dir_all(&dir).unwrap();
 
     let missing = dir.join("nope.xml");
-    let err = model::load(MjcfSource::File(&missing)).unwrap_err();
+    let err = Simulator::from_source(MjcfSource::File(&missing)).unwrap_err();
     assert!(matches!(err, KinovaError::MjcfUnreadable { .. }));
     assert!(err.to_string().contains("nope.xml"), "{err}");
 
@@ -181,7 +180,7 @@ fn missing_and_malformed_mjcf_files_are_clear_errors() {
         "<mujoco>\n  <worldbody>\n    <body name=\"a\">\n</mujoco>\n",
     )
     .unwrap();
-    let err = model::load(MjcfSource::File(&bad)).unwrap_err();
+    let err = Simulator::from_source(MjcfSource::File(&bad)).unwrap_err();
     assert!(matches!(err, KinovaError::MjcfMalformed { .. }), "{err}");
     assert!(err.to_string().contains("bad.xml"), "{err}");
 
@@ -191,7 +190,7 @@ fn missing_and_malformed_mjcf_files_are_clear_errors() {
         "<mujoco><worldbody><geom type=\"sphere\" size=\"0.1\"/></worldbody></mujoco>",
     )
     .unwrap();
-    let err = model::load(MjcfSource::File(&lacking)).unwrap_err();
+    let err = Simulator::from_source(MjcfSource::File(&lacking)).unwrap_err();
     assert!(err.to_string().contains("joint_1"), "{err}");
 
     // Through the config: the error reaches the caller as a HilError.
@@ -283,7 +282,7 @@ fn an_unknown_setting_is_a_clear_error() {
 #[test]
 #[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn calibration_does_not_depend_on_the_number_of_threads() {
-    use hil_kinova_mujoco::calibrate::{CalibrationOptions, calibrate_with};
+    use hil_kinova_mujoco::{CalibrationOptions, calibrate_with};
     let run = |threads| {
         let opts = CalibrationOptions {
             foods: vec![FoodKind::Banana],

@@ -3,10 +3,10 @@
 //! pitch β and roll γ through the fork's joints while the arm holds the
 //! handle's orientation.
 
-use hil_kinova_mujoco::controller::ACTIONS;
-use hil_kinova_mujoco::food::{FoodKind, FoodModel};
-use hil_kinova_mujoco::sim::{PUBLISHED_HOLD, PerceivedTarget, Placement, Simulator};
-use hil_kinova_mujoco::{Action, KinovaError};
+use hil_kinova_mujoco::{
+    ACTIONS, Action, FoodKind, FoodModel, KinovaError, PUBLISHED_HOLD, PerceivedTarget, Placement,
+    Simulator,
+};
 use rand::SeedableRng;
 
 /// Stages one item of `kind` at the plate centre (seeded) and executes `action`.

@@ -3,9 +3,9 @@
 //! `pretrain_foods` chooses the foods of the pretraining attempts.
 
 use hil_core::{ArmId, Environment};
-use hil_kinova_mujoco::env::simulated_pretraining;
-use hil_kinova_mujoco::food::{FoodKind, FoodModel};
-use hil_kinova_mujoco::{KinovaFeedingConfig, KinovaFeedingEnv};
+use hil_kinova_mujoco::{
+    FoodKind, FoodModel, KinovaFeedingConfig, KinovaFeedingEnv, simulated_pretraining,
+};
 use rand::SeedableRng;
 
 #[test]

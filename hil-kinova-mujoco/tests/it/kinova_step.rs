@@ -2,11 +2,10 @@
 //! the pre-pose, the hold) gives the outcomes of the model's own 1 ms step,
 //! and MuJoCo's warnings stay out of the working directory.
 
-use hil_kinova_mujoco::controller::ACTIONS;
-use hil_kinova_mujoco::food::{FoodKind, FoodModel};
-use hil_kinova_mujoco::sim::{FREE_DT, PerceivedTarget, Placement, Simulator};
-use hil_kinova_mujoco::skewer::{MAX_DT, REF_DT};
-use hil_kinova_mujoco::{AttemptReport, KinovaError};
+use hil_kinova_mujoco::{
+    ACTIONS, AttemptReport, FREE_DT, FoodKind, FoodModel, KinovaError, MAX_DT, PerceivedTarget,
+    Placement, REF_DT, Simulator,
+};
 use rand::SeedableRng;
 
 fn attempt(sim: &mut Simulator, kind: FoodKind, action: usize, seed: u64) -> AttemptReport {

@@ -1,5 +1,8 @@
 //! The integration tests of `hil-kinova-mujoco`, linked into one test binary (one
 //! link instead of one per file); each module was a file of its own.
+//! They need the MuJoCo simulation: `cargo test -p hil-kinova-mujoco
+//! --features physics` (scripts/test turns it on).
+#![cfg(feature = "physics")]
 
 mod kinova;
 mod kinova_hold_roll;

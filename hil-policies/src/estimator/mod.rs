@@ -4,16 +4,19 @@
 //! bonus b_a(x) = sqrt(xᵀA_a⁻¹x). Each arm is held in the cheaper of two
 //! exact representations ([`Representation`]): the kernel (Woodbury) form
 //! while it has few observations compared with d, a packed dense Cholesky
-//! factor beyond. Both agree with a direct inverse ([`reference`](mod@reference)) to
-//! rounding.
+//! factor beyond. Both agree with a direct inverse (the crate's test-only
+//! `reference` estimator) to rounding.
 
 mod checkpoint;
 mod dense;
 mod kernel;
 mod linalg;
 mod options;
-pub mod reference;
+#[cfg(test)]
+mod reference;
 mod store;
+#[cfg(test)]
+mod tests;
 
 use std::sync::Arc;
 

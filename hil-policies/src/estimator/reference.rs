@@ -9,15 +9,6 @@ use super::ArmEstimate;
 use hil_core::{HilError, Result};
 
 /// Per-arm observation lists, solved from scratch on demand.
-///
-/// ```
-/// use hil_policies::estimator::reference::NaiveArms;
-/// let mut n = NaiveArms::new(1, 2, 1.0);
-/// n.push(0, &[1.0, 0.0], 1.0);
-/// let e = n.estimate(0, &[1.0, 0.0]).unwrap();
-/// assert!((e.estimate - 0.5).abs() < 1e-15);
-/// assert!((e.bonus - 0.5f64.sqrt()).abs() < 1e-15);
-/// ```
 #[derive(Clone, Debug)]
 pub struct NaiveArms {
     dim: usize,
@@ -94,5 +85,20 @@ impl NaiveArms {
             estimate: est,
             bonus: q.max(0.0).sqrt(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_observation_by_hand() {
+        // λ = 1, x = e₁, r = 1: A = diag(2, 1), θ = (0.5, 0), bonus √0.5.
+        let mut n = NaiveArms::new(1, 2, 1.0);
+        n.push(0, &[1.0, 0.0], 1.0);
+        let e = n.estimate(0, &[1.0, 0.0]).unwrap();
+        assert!((e.estimate - 0.5).abs() < 1e-15);
+        assert!((e.bonus - 0.5f64.sqrt()).abs() < 1e-15);
     }
 }

@@ -3,6 +3,4 @@
 
 mod config;
 mod conformance;
-mod estimator_agreement;
-mod gap_monotonicity;
 mod session;

@@ -5,7 +5,6 @@ use hil_core::config::WorkloadModelConfig;
 use hil_core::{BuildContext, QueryHistory};
 
 fn parse(json: &str) -> Result<Box<dyn WorkloadModelConfig>, serde_json::Error> {
-    hil_workload::link();
     serde_json::from_str(json)
 }
 

@@ -5,13 +5,14 @@
 use hil_core::WorkloadInput;
 use hil_core::testing::check_workload_model;
 use hil_core::testing::strategies::{query_history, query_kind};
-use hil_core::{QueryHistory, WorkloadModel};
+use hil_core::{HilError, QueryHistory, WorkloadModel};
 use hil_workload::datasets::{Dataset, DatasetId};
 use hil_workload::features::SparseRow;
 use hil_workload::models::{FittedModel, GrangerModel, GrangerVariant, ModelSpec, Provenance};
 use hil_workload::select::{Candidate, SelectOptions, fit_on_all};
 use hil_workload::synth::SynthConfig;
 use proptest::prelude::*;
+use std::path::Path;
 
 fn small_d12() -> Dataset {
     let study = SynthConfig::small(10, 4).generate(3).unwrap();
@@ -78,27 +79,41 @@ fn model_files_from_other_versions_or_with_bad_fields_are_clear_errors() {
     let m = hil_workload::bundled::load_fitted("f1_sim").unwrap();
     let json = m.to_json();
     let v2 = json.replace("\"format_version\": 1", "\"format_version\": 2");
-    let e = FittedModel::from_json(&v2, "m.json".as_ref())
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("m.json:3") && e.contains("format_version") && e.contains("version 2"),
-        "{e}"
+    // Each refusal names the file, and the record (line) and field where
+    // the file says which.
+    let at = |text: &str| match FittedModel::from_json(text, "m.json".as_ref()).unwrap_err() {
+        HilError::Data {
+            path,
+            record,
+            field,
+            ..
+        } => (path, record, field),
+        other => panic!("not a data error: {other:?}"),
+    };
+    let (path, record, field) = at(&v2);
+    assert_eq!(
+        (path.as_path(), record, field.as_str()),
+        (Path::new("m.json"), 3, "format_version")
     );
     let wrong = json.replace("\"history\": 10", "\"history\": 9");
-    let e = FittedModel::from_json(&wrong, "m.json".as_ref())
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("m.json") && e.contains("history"), "{e}");
+    // A spec that disagrees with the weights, and an unknown key in the
+    // spec: the `spec` field, saying which part.
     let extra = json.replace("\"gamma\"", "\"gama\": 1, \"gamma\"");
-    let e = FittedModel::from_json(&extra, "m.json".as_ref())
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("gama"), "{e}");
-    let e = FittedModel::from_json("{}", "m.json".as_ref())
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("format"), "{e}");
+    for (text, part) in [(&wrong, "history"), (&extra, "gama")] {
+        match FittedModel::from_json(text, "m.json".as_ref()).unwrap_err() {
+            HilError::Data {
+                path, field, why, ..
+            } => {
+                assert_eq!(
+                    (path.as_path(), field.as_str()),
+                    (Path::new("m.json"), "spec")
+                );
+                assert!(why.contains(part), "{why}");
+            }
+            other => panic!("not a data error: {other:?}"),
+        }
+    }
+    assert_eq!(at("{}").2, "format");
     // bounds of the simulation variant are enforced on load
     let out = json.replacen("0.05,", "-0.5,", 1);
     assert!(FittedModel::from_json(&out, "m.json".as_ref()).is_err());

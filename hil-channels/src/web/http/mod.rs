@@ -21,6 +21,8 @@ use std::time::Duration;
 pub mod parse;
 mod server;
 mod slots;
+#[cfg(test)]
+mod tests;
 
 pub use server::Server;
 pub use slots::Occupancy;

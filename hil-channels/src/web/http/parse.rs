@@ -68,18 +68,6 @@ struct Head {
 /// if the client closes first. The request line is available from
 /// [`path`](Self::path) as soon as it is complete, before the headers,
 /// so that a server can tell early who is asking.
-///
-/// ```
-/// use hil_channels::web::http::parse::{Progress, RequestParser};
-/// let mut p = RequestParser::default();
-/// assert!(matches!(p.push(b"GET /abc/?x=1 HTTP/1.1\r\nHo"), Ok(Progress::NeedMore)));
-/// assert_eq!(p.path(), Some("/abc/"));
-/// let Ok(Progress::Complete(req)) = p.push(b"st: a\r\n\r\n") else { panic!() };
-/// assert_eq!((req.method.as_str(), req.header("host")), ("GET", Some("a")));
-/// // A refusal carries its status code.
-/// let mut p = RequestParser::default();
-/// assert_eq!(p.push(b"GET / HTTP/9\r\n\r\n").unwrap_err().status, 400);
-/// ```
 #[derive(Debug, Default)]
 pub struct RequestParser {
     buf: Vec<u8>,
@@ -114,7 +102,9 @@ impl RequestParser {
 
     /// How many bytes the parser holds. While it needs more, never more
     /// than [`MAX_HEAD_BYTES`] + 4 + [`MAX_BODY_BYTES`]: a connection's
-    /// memory is bounded whatever the client sends.
+    /// memory is bounded whatever the client sends (what the fuzz tests
+    /// check).
+    #[cfg(test)]
     pub fn buffered(&self) -> usize {
         self.buf.len()
     }
@@ -273,4 +263,29 @@ fn parse_fields(fields: &[u8], method: &str) -> Result<(HashMap<String, String>,
 
 fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
     hay.windows(needle.len()).position(|w| w == needle)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_request_arrives_in_pieces_and_a_refusal_carries_its_status() {
+        let mut p = RequestParser::default();
+        assert!(matches!(
+            p.push(b"GET /abc/?x=1 HTTP/1.1\r\nHo"),
+            Ok(Progress::NeedMore)
+        ));
+        // The request line is known before the headers are complete.
+        assert_eq!(p.path(), Some("/abc/"));
+        let Ok(Progress::Complete(req)) = p.push(b"st: a\r\n\r\n") else {
+            panic!("complete")
+        };
+        assert_eq!(
+            (req.method.as_str(), req.header("host")),
+            ("GET", Some("a"))
+        );
+        let mut p = RequestParser::default();
+        assert_eq!(p.push(b"GET / HTTP/9\r\n\r\n").unwrap_err().status, 400);
+    }
 }

@@ -38,12 +38,46 @@ pub fn lib(krate: &str) -> PathBuf {
     cdylib_path(plugin_dir(), krate)
 }
 
-/// A fresh scratch directory for one test.
-pub fn scratch(name: &str) -> PathBuf {
+/// Set (to anything) to keep the scratch directories of failed tests for
+/// a look afterwards; they are removed otherwise, passed or failed (the
+/// blank-folder guide test leaves a plugin build of several hundred MB).
+pub const KEEP_SCRATCH_ENV: &str = "HIL_KEEP_TEST_DIRS";
+
+/// A test's scratch directory, removed when dropped: at the end of the
+/// test, and while unwinding from its failure (then kept, and its path
+/// printed, if [`KEEP_SCRATCH_ENV`] is set).
+#[derive(Debug)]
+pub struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if std::thread::panicking() && std::env::var_os(KEEP_SCRATCH_ENV).is_some() {
+            eprintln!("kept {} ({KEEP_SCRATCH_ENV} is set)", self.0.display());
+            return;
+        }
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A fresh scratch directory for one test (see [`Scratch`]).
+pub fn scratch(name: &str) -> Scratch {
     let dir = std::env::temp_dir().join(format!("hil-plugin-tests-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
+    Scratch(dir)
 }
 
 /// Held by every test that drops a plugin object whose destructor panics:

@@ -1,14 +1,14 @@
 //! The "gap monotonicity" property suite for LinUCB-QG and its estimator.
 
+use crate::estimator::reference::NaiveArms;
+use crate::{
+    EstimatorOptions, LinUcbQg, LinUcbQgParams, LinearArms, RepresentationChoice, query_gap,
+};
 use hil_core::WorkloadInput;
 use hil_core::testing::strategies::context;
 use hil_core::{
     ArmId, Choice, Context, DecisionInput, LabelledObservation, Policy, QueryHistory, QueryKind,
     Result, WorkloadForecast, WorkloadModel,
-};
-use hil_policies::estimator::reference::NaiveArms;
-use hil_policies::{
-    EstimatorOptions, LinUcbQg, LinUcbQgParams, LinearArms, RepresentationChoice, query_gap,
 };
 use proptest::prelude::*;
 

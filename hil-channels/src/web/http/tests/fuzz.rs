@@ -11,8 +11,8 @@ use crate::web_support;
 
 use proptest::prelude::*;
 
-use hil_channels::web::http::parse::{Progress, RequestParser};
-use hil_channels::web::http::{MAX_BODY_BYTES, MAX_HEAD_BYTES};
+use crate::web::http::parse::{Progress, RequestParser};
+use crate::web::http::{MAX_BODY_BYTES, MAX_HEAD_BYTES};
 use web_support::{channel, get, raw};
 
 /// What the parser made of an input, in a comparable form.

@@ -1,4 +1,5 @@
-//! Property tests of the food-dataset readers: mutated `.npy` files and
+//! Property tests of the food-dataset readers (unit tests: the `.npy`
+//! reader is private to the crate): mutated `.npy` files and
 //! mutated manifests (truncations, bit flips, junk, huge and non-finite
 //! numbers) are either read or refused with an error that names the file
 //! at fault, never a panic; nothing is allocated from a declared size
@@ -6,10 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::dataset::FoodDataset;
+use crate::npy::{NpyArray, read_npy_bytes, write_npy, write_npy_bytes};
 use hil_core::HilError;
 use hil_core::testing::mutate::mutated;
-use hil_envs::dataset::FoodDataset;
-use hil_envs::npy::{NpyArray, read_npy_bytes, write_npy, write_npy_bytes};
 use proptest::prelude::*;
 
 /// The file an error names, whatever its kind.

@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use hil_channels::web::http::{Limits, Occupancy, Request, Response, Server, Service};
+use crate::web::http::{Limits, Occupancy, Request, Response, Server, Service};
 use hil_core::{Answer, ArmId, ResponseType};
 use web_support::{ask_async, channel, get, open_id, post, query, same_origin};
 

@@ -2,9 +2,9 @@
 //! relative, through pretraining, online updates, crossovers, duplicates
 //! and checkpoints.
 
+use crate::estimator::reference::NaiveArms;
+use crate::{EstimatorOptions, LinearArms, Representation, RepresentationChoice};
 use hil_core::{ArmId, Context, LabelledObservation};
-use hil_policies::estimator::reference::NaiveArms;
-use hil_policies::{EstimatorOptions, LinearArms, Representation, RepresentationChoice};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -183,32 +183,54 @@ fn checkpoint_round_trip_is_bit_exact() {
 
 #[test]
 fn bad_input_is_an_error_naming_the_value() {
-    let err = |r: hil_core::Result<LinearArms>| r.unwrap_err().to_string();
-    assert!(err(LinearArms::new(2, 3, 0.0)).contains("lambda"));
-    assert!(err(LinearArms::new(2, 3, -1.0)).contains("lambda"));
-    assert!(err(LinearArms::new(2, 3, f64::NAN)).contains("lambda"));
-    assert!(err(LinearArms::new(0, 3, 1.0)).contains("n_arms"));
+    use hil_core::HilError;
+    let parameter = |r: hil_core::Result<LinearArms>| match r.unwrap_err() {
+        HilError::InvalidParameter { name, .. } => name,
+        other => panic!("not an invalid parameter: {other:?}"),
+    };
+    assert_eq!(parameter(LinearArms::new(2, 3, 0.0)), "lambda");
+    assert_eq!(parameter(LinearArms::new(2, 3, -1.0)), "lambda");
+    assert_eq!(parameter(LinearArms::new(2, 3, f64::NAN)), "lambda");
+    assert_eq!(parameter(LinearArms::new(0, 3, 1.0)), "n_arms");
     let bad = EstimatorOptions {
         crossover: 0.0,
         ..Default::default()
     };
-    assert!(err(LinearArms::with_options(2, 3, 1.0, bad)).contains("crossover"));
+    assert_eq!(
+        parameter(LinearArms::with_options(2, 3, 1.0, bad)),
+        "crossover"
+    );
 
     let mut e = LinearArms::new(2, 3, 1.0).unwrap();
     let x = Context::new(vec![1.0, 2.0, 3.0]).unwrap();
-    let msg = e
-        .scores(&[1.0, f64::INFINITY, 0.0])
-        .unwrap_err()
-        .to_string();
-    assert!(msg.contains("context[1]") && msg.contains("inf"), "{msg}");
-    let msg = e.scores(&[1.0, 2.0]).unwrap_err().to_string();
-    assert!(msg.contains("expected 3, got 2"), "{msg}");
-    let msg = e.update(&x, ArmId(2), 1.0).unwrap_err().to_string();
-    assert!(msg.contains("arm 2") && msg.contains("2 arms"), "{msg}");
-    let msg = e.update(&x, ArmId(0), f64::NAN).unwrap_err().to_string();
-    assert!(msg.contains("reward"), "{msg}");
+    let r = e.scores(&[1.0, f64::INFINITY, 0.0]).unwrap_err();
+    assert!(
+        matches!(r, HilError::InvalidInput { ref what, ref why } if what == "context[1]" && why.contains("inf")),
+        "{r:?}"
+    );
+    let r = e.scores(&[1.0, 2.0]).unwrap_err();
+    assert!(
+        matches!(
+            r,
+            HilError::DimensionMismatch {
+                expected: 3,
+                got: 2
+            }
+        ),
+        "{r:?}"
+    );
+    let r = e.update(&x, ArmId(2), 1.0).unwrap_err();
+    assert!(
+        matches!(r, HilError::ArmOutOfRange { arm: 2, n_arms: 2 }),
+        "{r:?}"
+    );
+    let r = e.update(&x, ArmId(0), f64::NAN).unwrap_err();
+    assert!(
+        matches!(r, HilError::InvalidInput { ref what, .. } | HilError::InvalidParameter { name: ref what, .. } if what == "reward"),
+        "{r:?}"
+    );
     let wrong = Context::new(vec![1.0; 4]).unwrap();
-    let msg = e
+    let r = e
         .pretrain(&[
             LabelledObservation {
                 context: x.clone(),
@@ -221,11 +243,14 @@ fn bad_input_is_an_error_naming_the_value() {
                 reward: 1.0,
             },
         ])
-        .unwrap_err()
-        .to_string();
+        .unwrap_err();
+    // The record at fault (#1) is named with the mismatch.
+    let msg = r.to_string();
     assert!(
-        msg.contains("record #1") && msg.contains("expected 3, got 4"),
-        "{msg}"
+        matches!(r, HilError::InvalidInput { .. })
+            && msg.contains("record #1")
+            && msg.contains("expected 3, got 4"),
+        "{r:?}"
     );
     // Nothing was applied from the rejected batch.
     assert_eq!(e.n_observations(ArmId(0)).unwrap(), 0);

@@ -257,10 +257,59 @@ class FoodReplayEnv(HilEnv):
         super().__init__(environment=environment, **kwargs)
 
 
+class KinovaFeedingEnv(HilEnv):
+    """``hil/KinovaFeeding-v0``: the Kinova Gen3 feeding environment in MuJoCo.
+
+    Registered only when hil was built with the ``kinova`` feature
+    (``hil.KINOVA``; MuJoCo set up by ``scripts/setup-mujoco``). Each
+    attempt is a simulated skewering with contact physics; the context is
+    what the robot perceives of the item.
+
+    Args:
+        plate: foods on the plate (e.g. ``["banana", "carrot"]``).
+        context_dim: dimension of the perceived context.
+        pretraining_trials: simulated attempts per (pretraining food, action)
+            offered to policies for pretraining.
+        (Each left as None takes the Rust environment's default.)
+        **kwargs: the other fields of the environment's table
+            (``settings``, ``pretrain_foods``, ``hold_s``...) and, under
+            ``session=`` etc., the arguments of :class:`HilEnv`.
+    """
+
+    def __init__(
+        self,
+        plate: Optional[list[str]] = None,
+        context_dim: Optional[int] = None,
+        pretraining_trials: Optional[int] = None,
+        session: Optional[dict] = None,
+        workload: Optional[dict] = None,
+        channel: Optional[dict] = None,
+        workload_weight: float = 0.0,
+        build_seed: int = 0,
+        **fields: Any,
+    ) -> None:
+        given = {"plate": plate, "context_dim": context_dim, "pretraining_trials": pretraining_trials}
+        environment: dict[str, Any] = {
+            "type": "kinova_feeding",
+            **{k: (list(v) if k == "plate" else v) for k, v in given.items() if v is not None},
+            **fields,
+        }
+        super().__init__(
+            environment=environment,
+            session=session,
+            workload=workload,
+            channel=channel,
+            workload_weight=workload_weight,
+            build_seed=build_seed,
+        )
+
+
 def register_envs() -> None:
     """Registers hil's environments with Gymnasium (idempotent)."""
     if "hil/FoodReplay-v0" not in gym.registry:
         gym.register(id="hil/FoodReplay-v0", entry_point="hil.envs:FoodReplayEnv")
+    if _hil.KINOVA and "hil/KinovaFeeding-v0" not in gym.registry:
+        gym.register(id="hil/KinovaFeeding-v0", entry_point="hil.envs:KinovaFeedingEnv")
 
 
 register_envs()

@@ -94,6 +94,12 @@ create_exception!(
 );
 create_exception!(
     hil,
+    UnsupportedError,
+    HilError,
+    "A component does not support what it was asked (`component`, `operation`, `why`), e.g. the Kinova environment in a build without MuJoCo."
+);
+create_exception!(
+    hil,
     PluginError,
     HilError,
     "A plugin failed to load, handshake or run (`path`, `why`)."
@@ -184,6 +190,16 @@ fn class_and_fields<'py>(
             d.set_item("backend", backend)?;
             d.set_item("why", why)?;
             (py.get_type::<BackendError>(), "Backend")
+        }
+        RustError::Unsupported {
+            component,
+            operation,
+            why,
+        } => {
+            d.set_item("component", component)?;
+            d.set_item("operation", operation)?;
+            d.set_item("why", why)?;
+            (py.get_type::<UnsupportedError>(), "Unsupported")
         }
         RustError::Plugin { path, why } => {
             d.set_item("path", path.to_string_lossy())?;
@@ -336,6 +352,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ChannelError", py.get_type::<ChannelError>())?;
     m.add("BackendError", py.get_type::<BackendError>())?;
     m.add("PluginError", py.get_type::<PluginError>())?;
+    m.add("UnsupportedError", py.get_type::<UnsupportedError>())?;
     m.add("ConformanceError", py.get_type::<ConformanceError>())?;
     Ok(())
 }

@@ -19,6 +19,7 @@ KINDS = [
     hil.ChannelError,
     hil.BackendError,
     hil.PluginError,
+    hil.UnsupportedError,
     hil.ConformanceError,
 ]
 
@@ -66,3 +67,11 @@ def test_a_missing_file_is_an_io_error_naming_it(tmp_path):
 def test_an_unknown_bundled_model_is_refused():
     with pytest.raises(hil.HilError):
         hil.WorkloadModel.bundled("f3_sim")
+
+
+@pytest.mark.skipif(hil.KINOVA, reason="this build has the Kinova environment")
+def test_the_kinova_environment_without_mujoco_is_unsupported_and_says_how_to_enable_it():
+    with pytest.raises(hil.UnsupportedError) as caught:
+        hil.Environment("kinova_feeding", plate=["banana"])
+    assert caught.value.kind == "Unsupported"
+    assert caught.value.component and caught.value.why

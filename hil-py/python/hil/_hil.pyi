@@ -84,6 +84,11 @@ class PluginError(HilError):
     path: str
     why: str
 
+class UnsupportedError(HilError):
+    component: str
+    operation: str
+    why: str
+
 class ConformanceError(HilError):
     subject: str
     check: str

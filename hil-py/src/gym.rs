@@ -878,37 +878,19 @@ fn study_fit_json(
     candidate_json: &str,
     seed: u64,
 ) -> PyResult<String> {
-    use hil_workload::datasets::{Dataset, DatasetId};
-    use hil_workload::models::{FittedModel, Provenance};
-    use hil_workload::select::{Candidate, SelectOptions, fit_on_all};
+    use hil_workload::datasets::DatasetId;
+    use hil_workload::models::FittedModel;
+    use hil_workload::select::{Candidate, SelectOptions, fit_study_model};
     let cand: Candidate = parse_json("workload candidate", candidate_json).map_err(to_py_err)?;
     let fitted = py
         .detach(|| -> hil_core::Result<FittedModel> {
             let study = hil_workload::study::Study::load(Path::new(path))?;
             let id = DatasetId::parse(population)?;
-            let d = Dataset::build(&study, id)?;
             let opts = SelectOptions {
                 seed,
                 ..SelectOptions::default()
             };
-            let (spec, lambda) = fit_on_all(&d, cand, &opts)?;
-            let name = format!(
-                "{}_{}{}",
-                cand.label(),
-                id.as_str(),
-                cand.history().map_or(String::new(), |h| format!("_h{h}"))
-            );
-            Ok(FittedModel::new(
-                name,
-                spec,
-                Provenance {
-                    dataset: Some(id.as_str().into()),
-                    data: Some(path.to_string()),
-                    n_pairs: Some(d.pairs.len()),
-                    cv_test_mse: None,
-                    note: lambda.map(|l| format!("ridge λ = {l} chosen by 5-fold CV")),
-                },
-            ))
+            fit_study_model(&study, id, cand, &opts, None)
         })
         .map_err(to_py_err)?;
     serde_json::to_string_pretty(&fitted)

@@ -7,8 +7,8 @@ use std::sync::Arc;
 
 use hil_workload::bundle::{StudySummary, bundled_study};
 use hil_workload::datasets::{Dataset, DatasetId};
-use hil_workload::models::{FittedModel, Provenance};
-use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_on_all};
+use hil_workload::models::FittedModel;
+use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_study_model};
 use hil_workload::study::Study;
 use pyo3::prelude::*;
 
@@ -137,26 +137,7 @@ pub(crate) fn fit_workload(
     let opts = options(cv_seed, threads);
     let fitted = py
         .detach(|| -> hil_core::Result<FittedModel> {
-            let d = Dataset::build(&study, id)?;
-            let (spec, lambda) = fit_on_all(&d, cand, &opts)?;
-            let name = name.unwrap_or_else(|| {
-                format!(
-                    "{model}_{}{}",
-                    id.as_str(),
-                    cand.history().map_or(String::new(), |h| format!("_h{h}"))
-                )
-            });
-            let m = FittedModel::new(
-                name,
-                spec,
-                Provenance {
-                    dataset: Some(id.as_str().into()),
-                    data: Some(study.source().display().to_string()),
-                    n_pairs: Some(d.pairs.len()),
-                    cv_test_mse: None,
-                    note: lambda.map(|l| format!("ridge λ = {l} chosen by 5-fold CV")),
-                },
-            );
+            let m = fit_study_model(&study, id, cand, &opts, name)?;
             if let Some(path) = &out {
                 m.save(path)?;
             }

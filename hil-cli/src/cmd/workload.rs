@@ -8,8 +8,8 @@ use hil_core::WorkloadInput;
 use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadModel};
 use hil_workload::bundle::{StudySummary, build_bundle, bundled_study};
 use hil_workload::datasets::{Dataset, DatasetId};
-use hil_workload::models::{FittedModel, Provenance};
-use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_on_all};
+use hil_workload::models::FittedModel;
+use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_study_model};
 use hil_workload::study::Study;
 use hil_workload::synth::SynthConfig;
 
@@ -255,34 +255,14 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let study = Study::load(&data)?;
             let id = DatasetId::parse(&population)?;
             let cand = Candidate::parse(&model, history)?;
-            let d = Dataset::build(&study, id)?;
-            let (spec, lambda) = fit_on_all(&d, cand, &cv.options())?;
-            let name = name.unwrap_or_else(|| {
-                format!(
-                    "{}_{}{}",
-                    model,
-                    id.as_str(),
-                    cand.history().map_or(String::new(), |h| format!("_h{h}"))
-                )
-            });
-            let m = FittedModel::new(
-                name,
-                spec,
-                Provenance {
-                    dataset: Some(id.as_str().into()),
-                    data: Some(data.display().to_string()),
-                    n_pairs: Some(d.pairs.len()),
-                    cv_test_mse: None,
-                    note: lambda.map(|l| format!("ridge λ = {l} chosen by 5-fold CV")),
-                },
-            );
+            let m = fit_study_model(&study, id, cand, &cv.options(), name)?;
             m.save(&out)?;
             println!(
                 "wrote {} ({} on {}, {} pairs)",
                 out.display(),
                 cand.label(),
                 id.as_str().to_uppercase(),
-                d.pairs.len()
+                m.provenance.n_pairs.unwrap_or_default()
             );
             Ok(())
         }

@@ -7,10 +7,9 @@
 
 fn main() {
     println!("cargo::rerun-if-env-changed=MUJOCO_DYNAMIC_LINK_DIR");
-    // Without the `kinova` feature nothing links MuJoCo.
-    if std::env::var_os("CARGO_FEATURE_KINOVA").is_none() {
-        return;
-    }
+    // Set even without the `kinova` feature: a workspace build that turns
+    // on hil-kinova-mujoco's `physics` for another crate links MuJoCo here
+    // too (feature unification), and an unused rpath costs nothing.
     if let Ok(dir) = std::env::var("MUJOCO_DYNAMIC_LINK_DIR") {
         println!("cargo::rustc-link-arg=-Wl,-rpath,{dir}");
     }

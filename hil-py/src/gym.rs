@@ -624,13 +624,6 @@ impl PolicyState {
     }
 }
 
-fn context_of(x: &PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
-    let values = x
-        .as_slice()
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Context::new(values).map_err(to_py_err)
-}
-
 #[pymethods]
 impl NativePolicy {
     /// A policy from its config table as JSON, for `n_arms` arms and
@@ -758,7 +751,7 @@ impl NativePolicy {
     /// Decides for context `x` at timestep `t` on its own: an arm, or
     /// `n_arms` to ask (the query is added to its own history).
     fn decide(&self, py: Python<'_>, x: PyReadonlyArray1<'_, f64>, t: Timestep) -> PyResult<usize> {
-        let context = context_of(&x)?;
+        let context = crate::convert::context(x)?;
         let mut guard = self.state()?;
         let state: &mut PolicyState = &mut guard;
         py.detach(|| {
@@ -793,7 +786,7 @@ impl NativePolicy {
         t: Timestep,
         from_expert: bool,
     ) -> PyResult<()> {
-        let context = context_of(&x)?;
+        let context = crate::convert::context(x)?;
         let mut guard = self.state()?;
         let state: &mut PolicyState = &mut guard;
         py.detach(|| {

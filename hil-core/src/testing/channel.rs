@@ -61,14 +61,11 @@ fn run(
     opts: &CheckOptions,
     only: Option<Check>,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    let make = &super::guarded(make, |o, lib| {
-        let name = o.name().to_string();
-        Ok(Box::new(crate::plugin::GuardedChannel::new(o, lib, &name)?) as Box<dyn QueryChannel>)
-    });
-    let build_failure = |e: crate::HilError| ConformanceFailure::of_factory("query channel", &e);
-    opts.validate().map_err(build_failure)?;
-    let mut a = make().map_err(build_failure)?;
-    let mut c = Checker::new(a.name(), only);
+    let super::Started {
+        make,
+        first: mut a,
+        checker: mut c,
+    } = super::start(make, opts, only)?;
     let ra = answers(&mut c, a.as_mut(), opts)?;
     if c.wants(Check::SeededReplay) {
         let mut b = c.ok(Check::Build, make())?;

@@ -57,17 +57,11 @@ fn run(
     opts: &CheckOptions,
     only: Option<Check>,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    let make = &super::guarded(make, |o, lib| {
-        let name = o.name().to_string();
-        Ok(
-            Box::new(crate::plugin::GuardedEnvironment::new(o, lib, &name)?)
-                as Box<dyn Environment>,
-        )
-    });
-    let build_failure = |e: HilError| ConformanceFailure::of_factory("environment", &e);
-    opts.validate().map_err(build_failure)?;
-    let mut a = make().map_err(build_failure)?;
-    let mut c = Checker::new(a.name(), only);
+    let super::Started {
+        make,
+        first: mut a,
+        checker: mut c,
+    } = super::start(make, opts, only)?;
     let build = |c: &Checker| c.ok(Check::Build, make());
     let n_arms = a.action_space().len();
     let dim = a.context_dim();

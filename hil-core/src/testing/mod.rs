@@ -182,14 +182,70 @@ fn under_test() -> std::path::PathBuf {
     std::path::PathBuf::from("<object under test>")
 }
 
-/// Runs `make`'s objects under the plugin panic guard (again, for a
-/// plugin's), so a panic in a method is reported as a failure of the check
-/// that called it instead of unwinding through the suite.
-pub(crate) fn guarded<T: ?Sized>(
-    make: &dyn Fn() -> crate::Result<Box<T>>,
-    wrap: impl Fn(Box<T>, std::path::PathBuf) -> crate::Result<Box<T>>,
-) -> impl Fn() -> crate::Result<Box<T>> {
-    move || wrap(make()?, under_test())
+/// A kind of object a factory-driven suite checks (policy, query channel,
+/// environment): what its factory is called in a failure, and how one
+/// instance goes under the plugin panic guard.
+pub(crate) trait UnderTest {
+    /// The factory's name in a [`Check::Build`] failure (e.g. `policy`).
+    const WHAT: &'static str;
+    /// The object's own name, which the report names.
+    fn subject_name(&self) -> &str;
+    /// `self` under the plugin panic guard (again, for a plugin's).
+    fn guard(self: Box<Self>) -> crate::Result<Box<Self>>;
+}
+
+macro_rules! under_test {
+    ($($tr:ident => $guard:ident, $what:literal;)*) => {$(
+        impl UnderTest for dyn crate::$tr {
+            const WHAT: &'static str = $what;
+            fn subject_name(&self) -> &str {
+                self.name()
+            }
+            fn guard(self: Box<Self>) -> crate::Result<Box<Self>> {
+                let name = self.name().to_string();
+                Ok(Box::new(crate::plugin::$guard::new(self, under_test(), &name)?))
+            }
+        }
+    )*};
+}
+
+under_test! {
+    Policy => GuardedPolicy, "policy";
+    QueryChannel => GuardedChannel, "query channel";
+    Environment => GuardedEnvironment, "environment";
+}
+
+/// A factory-driven suite, started: see [`start`].
+pub(crate) struct Started<M, T: ?Sized> {
+    /// Builds a fresh guarded instance.
+    pub make: M,
+    /// The first instance, already built.
+    pub first: Box<T>,
+    /// Reports under the first instance's name.
+    pub checker: Checker,
+}
+
+/// How every factory-driven suite starts: `make`'s objects come under the
+/// plugin panic guard, so a panic in a method is reported as a failure of
+/// the check that called it instead of unwinding through the suite; the
+/// options are validated and a first instance is built (a failure of
+/// either is a [`Check::Build`] failure of the factory); the checker
+/// reports under that instance's name and runs `only` check, or all.
+pub(crate) fn start<'m, T: UnderTest + ?Sized>(
+    make: &'m dyn Fn() -> crate::Result<Box<T>>,
+    opts: &CheckOptions,
+    only: Option<Check>,
+) -> Result<Started<impl Fn() -> crate::Result<Box<T>> + 'm, T>, ConformanceFailure> {
+    let make = move || make()?.guard();
+    let build_failure = |e: HilError| ConformanceFailure::of_factory(T::WHAT, &e);
+    opts.validate().map_err(build_failure)?;
+    let first = make().map_err(build_failure)?;
+    let checker = Checker::new(first.subject_name(), only);
+    Ok(Started {
+        make,
+        first,
+        checker,
+    })
 }
 
 impl ConformanceFailure {

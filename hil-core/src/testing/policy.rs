@@ -65,14 +65,11 @@ fn run(
     opts: &CheckOptions,
     only: Option<Check>,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    let make = &super::guarded(make, |o, lib| {
-        let name = o.name().to_string();
-        Ok(Box::new(crate::plugin::GuardedPolicy::new(o, lib, &name)?) as Box<dyn Policy>)
-    });
-    opts.validate()
-        .map_err(|e| ConformanceFailure::of_factory("policy", &e))?;
-    let first = make().map_err(|e| ConformanceFailure::of_factory("policy", &e))?;
-    let mut c = Checker::new(first.name(), only);
+    let super::Started {
+        make,
+        first,
+        checker: mut c,
+    } = super::start(make, opts, only)?;
     drop(first);
     let build = |c: &Checker| c.ok(Check::Build, make());
 

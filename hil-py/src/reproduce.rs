@@ -11,7 +11,7 @@ use hil_experiments::output::{Timing, write_outputs};
 use hil_experiments::testbed::{ModelSource, RunOutcome};
 use hil_experiments::{Method, Protocol, ProtocolSettings};
 use pyo3::prelude::*;
-use pyo3::types::{PyCFunction, PyDict, PyTuple};
+use pyo3::types::{PyDict, PyTuple};
 use serde_json::Value;
 
 use crate::convert::{from_py, to_py};
@@ -137,6 +137,38 @@ impl PythonComponents<'_, '_> {
     }
 }
 
+/// A factory that returns one object whatever it is called with (a
+/// workload model shared by every run); it pickles as that object, so a
+/// Ray worker can get it.
+#[pyclass(module = "hil._hil", name = "_Constant", frozen)]
+struct Constant {
+    object: Py<PyAny>,
+}
+
+#[pymethods]
+impl Constant {
+    #[new]
+    fn new(object: Py<PyAny>) -> Self {
+        Self { object }
+    }
+
+    #[pyo3(signature = (*_args, **_kwargs))]
+    fn __call__(
+        &self,
+        py: Python<'_>,
+        _args: &Bound<'_, PyTuple>,
+        _kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> Py<PyAny> {
+        self.object.clone_ref(py)
+    }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (Bound<'py, pyo3::types::PyType>, (Py<PyAny>,)) {
+        (slf.get_type(), (slf.get().object.clone_ref(slf.py()),))
+    }
+}
+
 /// A Python factory's name: its `__name__` (a class or function), else
 /// its type's.
 fn python_name(obj: &Bound<'_, PyAny>) -> String {
@@ -181,10 +213,12 @@ fn component_table(
         !factory.is_instance_of::<pyo3::types::PyType>() && factory.hasattr(m).unwrap_or(false)
     });
     let factory = if is_instance {
-        let object = factory.clone().unbind();
-        PyCFunction::new_closure(py, None, None, move |args, _kwargs| {
-            Ok::<_, PyErr>(object.clone_ref(args.py()))
-        })?
+        Bound::new(
+            py,
+            Constant {
+                object: factory.clone().unbind(),
+            },
+        )?
         .into_any()
     } else if factory.is_callable() {
         factory
@@ -337,5 +371,6 @@ fn rayon_threads() -> usize {
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Constant>()?;
     m.add_function(wrap_pyfunction!(reproduce, m)?)
 }

@@ -808,6 +808,39 @@ impl Protocol {
         (label, seeds)
     }
 
+    /// `e`, raised by run `key`, naming the run: a component's failure
+    /// (a backend or query channel, e.g. a Python component's exception)
+    /// keeps its kind and source; anything else becomes a protocol state
+    /// error.
+    fn in_run(&self, key: &RunKey, e: HilError) -> HilError {
+        let m = &self.settings.methods[key.method];
+        let run = format!(
+            "run of `{}` {:?} ({:?}, seed {}, policy seed {})",
+            m.label, key.point, key.phase, key.seed, key.policy_seed
+        );
+        match e {
+            HilError::Backend {
+                backend,
+                why,
+                source,
+            } => HilError::Backend {
+                backend,
+                why: format!("{why} (in the {run})"),
+                source,
+            },
+            HilError::Channel {
+                channel,
+                why,
+                source,
+            } => HilError::Channel {
+                channel,
+                why: format!("{why} (in the {run})"),
+                source,
+            },
+            e => HilError::state("protocol", format!("{run} failed: {e}")),
+        }
+    }
+
     /// Runs one episode.
     pub fn run_one(&self, key: &RunKey, ctx: &TaskContext) -> Result<RunRecord> {
         let s = &self.settings;
@@ -911,16 +944,9 @@ impl Protocol {
                 if cancel.load(Ordering::Relaxed) {
                     return None;
                 }
-                let r = self.run_one(key, &ctx).map_err(|e| {
-                    let m = &self.settings.methods[key.method];
-                    HilError::state(
-                        "protocol",
-                        format!(
-                            "run of `{}` {:?} ({:?}, seed {}, policy seed {}) failed: {e}",
-                            m.label, key.point, key.phase, key.seed, key.policy_seed
-                        ),
-                    )
-                });
+                let r = self
+                    .run_one(key, &ctx)
+                    .map_err(|e| self.in_run(key, e));
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
                 Some(r)
             })

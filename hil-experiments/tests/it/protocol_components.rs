@@ -232,3 +232,34 @@ fn a_raised_cancel_flag_stops_the_run() {
         RunOutcome::Finished(r) if r.len() == total
     ));
 }
+
+/// A channel that fails at its first query.
+struct Offline;
+
+impl QueryChannel for Offline {
+    fn name(&self) -> &str {
+        "offline"
+    }
+
+    fn ask(&mut self, _query: &Query) -> hil_core::Result<Response> {
+        Err(HilError::channel("offline", "the tablet is off"))
+    }
+}
+
+#[test]
+fn a_failing_component_keeps_its_error_kind_and_names_the_run() {
+    let (p, _) = small();
+    let e = p
+        .with_channel(Arc::new(|_: &TaskContext| {
+            Ok(Box::new(Offline) as Box<dyn QueryChannel>)
+        }))
+        .run_all(&|_, _| {})
+        .unwrap_err();
+    match &e {
+        HilError::Channel { channel, why, .. } => {
+            assert_eq!(channel, "offline");
+            assert!(why.contains("the tablet is off") && why.contains("run of `"), "{why}");
+        }
+        other => panic!("expected a channel error, got {other:?}"),
+    }
+}

@@ -221,12 +221,10 @@ impl ConfiguredEnvironment {
                 toml::Value::String(p.to_string_lossy().into_owned()),
             );
         }
-        let invalid = |why: String| {
-            HilError::invalid_parameter("environment", type_of(&self.table), why)
-        };
-        let config =
-            hil_core::plugin::component::<_, dyn EnvironmentConfig>(toml::Value::Table(t))
-                .map_err(|e: toml::de::Error| invalid(e.message().trim().to_string()))?;
+        let invalid =
+            |why: String| HilError::invalid_parameter("environment", type_of(&self.table), why);
+        let config = hil_core::plugin::component::<_, dyn EnvironmentConfig>(toml::Value::Table(t))
+            .map_err(|e: toml::de::Error| invalid(e.message().trim().to_string()))?;
         config.validate().map_err(|e| invalid(e.to_string()))?;
         Ok(config)
     }

@@ -944,9 +944,7 @@ impl Protocol {
                 if cancel.load(Ordering::Relaxed) {
                     return None;
                 }
-                let r = self
-                    .run_one(key, &ctx)
-                    .map_err(|e| self.in_run(key, e));
+                let r = self.run_one(key, &ctx).map_err(|e| self.in_run(key, e));
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
                 Some(r)
             })

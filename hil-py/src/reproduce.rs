@@ -162,9 +162,7 @@ impl Constant {
         self.object.clone_ref(py)
     }
 
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> (Bound<'py, pyo3::types::PyType>, (Py<PyAny>,)) {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, pyo3::types::PyType>, (Py<PyAny>,)) {
         (slf.get_type(), (slf.get().object.clone_ref(slf.py()),))
     }
 }

@@ -134,6 +134,10 @@ fn protocol_run_all_json(
     }
 }
 
+/// A registration as Python sees it: `(kind, type name, factory)`, the
+/// arguments of `hil.register`.
+type RegistrationTuple = (&'static str, String, Py<PyAny>);
+
 /// The settings `settings_json` with the Python components added (as
 /// `hil.reproduce` takes them), and the registrations a Ray worker must
 /// repeat before running jobs: `(settings_json, [(kind, name, factory)])`.
@@ -145,7 +149,7 @@ fn protocol_with_components(
     channel: Option<&Bound<'_, PyAny>>,
     environment: Option<&Bound<'_, PyAny>>,
     workload_models: Option<&Bound<'_, PyDict>>,
-) -> PyResult<(String, Vec<(&'static str, String, Py<PyAny>)>)> {
+) -> PyResult<(String, Vec<RegistrationTuple>)> {
     let mut settings: ProtocolSettings = from_json("protocol settings", settings_json)?;
     let regs = PythonComponents {
         extra_methods,

@@ -58,7 +58,9 @@ impl QueryChannel for WrongExpert {
     }
 
     fn ask(&mut self, query: &Query) -> hil_core::Result<Response> {
-        let best = query.oracle_best.expect("the dataset knows the best action");
+        let best = query
+            .oracle_best
+            .expect("the dataset knows the best action");
         Ok(Response::action(ArmId((best.0 + 1) % query.actions.len())))
     }
 }
@@ -158,7 +160,10 @@ fn bad_channel_and_environment_tables_are_named() {
     // naming the environment.
     let other = |_: &EpisodeSpec<'_>| -> hil_core::Result<Box<dyn hil_core::Environment>> {
         let actions = hil_core::ActionSpace::new(["skewer", "scoop"])?;
-        Ok(Box::new(TableEnv::new(actions, vec![("pea", vec![0.2, 0.9])])?))
+        Ok(Box::new(TableEnv::new(
+            actions,
+            vec![("pea", vec![0.2, 0.9])],
+        )?))
     };
     let e = new(settings)
         .unwrap()
@@ -258,7 +263,10 @@ fn a_failing_component_keeps_its_error_kind_and_names_the_run() {
     match &e {
         HilError::Channel { channel, why, .. } => {
             assert_eq!(channel, "offline");
-            assert!(why.contains("the tablet is off") && why.contains("run of `"), "{why}");
+            assert!(
+                why.contains("the tablet is off") && why.contains("run of `"),
+                "{why}"
+            );
         }
         other => panic!("expected a channel error, got {other:?}"),
     }

@@ -19,6 +19,11 @@
 //!    validation with the deciding model (as the paper's numbers show: its
 //!    cross-data r_task and f_q equal the same-model rows).
 //!
+//! What answers queries, what presents the items and the workload models
+//! are pluggable ([`crate::components`], [`ModelSource`]): the paper's
+//! perfect expert and dataset replay by default, any registered type from
+//! the settings, or a factory given in code.
+//!
 //! Scoring is hil-core's, the paper's: ΔWL = f(WL_0, Q_T) − WL_0 at the
 //! episode's final timestep ([`EpisodeMetrics`]); nothing here recomputes it.
 //!

@@ -262,7 +262,10 @@ def test_python_components_run_on_ray_when_they_pickle():
     for module in (sys.modules[__name__], conftest):
         ray.cloudpickle.register_pickle_by_value(module)
     models = {"step": StepWorkload(step=0.2)}
-    on_ray = sweep(s, backend="ray", num_cpus=2, channel=WrongExpert, workload_models=models)
+    tasks = []
+    on_ray = sweep(s, backend="ray", num_cpus=2, channel=WrongExpert, workload_models=models,
+                   progress=lambda done, total: tasks.append((done, total)))
+    assert tasks and tasks[-1][0] == tasks[-1][1]
     local = sweep(s, backend="local", channel=WrongExpert, workload_models=models)
     assert ray.is_initialized()
     assert on_ray["records"] == local["records"]

@@ -244,6 +244,8 @@ impl ProtocolSettings {
         if let Some(d) = &mut s.dataset {
             *d = base.join(&*d);
         }
+        s.check_components()
+            .map_err(|e| hil_core::ConfigError::from_error(&text, path, &[], e))?;
         for m in &mut s.models {
             if let Some(f) = &mut m.file {
                 *f = base.join(&*f);
@@ -407,13 +409,7 @@ impl ProtocolSettings {
                 }
             }
         }
-        self.channel_factory()?;
-        if let Some(t) = &self.environment {
-            let env = ConfiguredEnvironment::new(t.clone())?;
-            for foods in [&self.split.validation, &self.split.test] {
-                env.config(foods, self.items_per_episode, self.dataset.as_deref())?;
-            }
-        }
+        self.check_components()?;
         for label in std::iter::once(&self.figures.rollout).chain(&self.figures.workload) {
             if self.method(label).is_none() {
                 return Err(HilError::invalid_parameter(
@@ -421,6 +417,19 @@ impl ProtocolSettings {
                     label,
                     "no method has that label",
                 ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that the `channel` and `environment` tables name known types
+    /// with valid parameters (the environment's for both phases).
+    pub fn check_components(&self) -> Result<()> {
+        self.channel_factory()?;
+        if let Some(t) = &self.environment {
+            let env = ConfiguredEnvironment::new(t.clone())?;
+            for foods in [&self.split.validation, &self.split.test] {
+                env.config(foods, self.items_per_episode, self.dataset.as_deref())?;
             }
         }
         Ok(())

@@ -271,3 +271,22 @@ fn a_failing_component_keeps_its_error_kind_and_names_the_run() {
         other => panic!("expected a channel error, got {other:?}"),
     }
 }
+
+#[test]
+fn a_settings_file_with_an_unknown_channel_type_names_file_line_and_field() {
+    let dir = std::env::temp_dir().join(format!("hil-protocol-settings-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("settings.toml");
+    let mut text = toml::to_string(&ProtocolSettings::quick()).unwrap();
+    text = format!("channel = {{ type = \"no_such_expert\" }}\n{text}");
+    std::fs::write(&path, &text).unwrap();
+    let e = ProtocolSettings::load(&path).unwrap_err();
+    std::fs::remove_dir_all(&dir).unwrap();
+    match &e {
+        HilError::Config(c) => {
+            assert_eq!((c.line, c.field.as_deref()), (1, Some("channel")), "{e}");
+            assert!(e.to_string().contains("settings.toml"), "{e}");
+        }
+        other => panic!("expected a config error, got {other:?}"),
+    }
+}

@@ -13,6 +13,8 @@
 //! - [`testbed`]: the paper's simulated-testbed protocol (methods as policy
 //!   configs, runs in parallel, hyperparameters chosen on validation, the
 //!   cross-data experiment);
+//! - [`components`]: the testbed's pluggable parts (the query channel and
+//!   environment of every episode; the paper's by default);
 //! - `user_study`: the paper's real-robot user-study protocol (methods
 //!   in counterbalanced order, per-plate results, mean ± standard error),
 //!   in the MuJoCo scene, so only with the crate feature `physics` (run
@@ -28,6 +30,7 @@
 pub mod builtin;
 pub mod calibrate;
 pub mod claims;
+pub mod components;
 pub mod method;
 pub mod output;
 pub mod plot;

@@ -19,6 +19,11 @@
 //!    validation with the deciding model (as the paper's numbers show: its
 //!    cross-data r_task and f_q equal the same-model rows).
 //!
+//! What answers queries, what presents the items and the workload models
+//! are pluggable ([`crate::components`], [`ModelSource`]): the paper's
+//! perfect expert and dataset replay by default, any registered type from
+//! the settings, or a factory given in code.
+//!
 //! Scoring is hil-core's, the paper's: ΔWL = f(WL_0, Q_T) − WL_0 at the
 //! episode's final timestep ([`EpisodeMetrics`]); nothing here recomputes it.
 //!
@@ -33,19 +38,23 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use hil_core::config::{BuildContext, TaskContext};
+use hil_core::config::{BuildContext, TaskContext, WorkloadModelConfig};
 use hil_core::session::{ComponentSeeds, splitmix};
 use hil_core::{
-    EpisodeMetrics, HilError, QueryChannel, Result, Session, SessionSettings, StepDecision,
-    Timestep, WorkloadModel,
+    EpisodeMetrics, HilError, Result, Session, SessionSettings, StepDecision, Timestep,
+    WorkloadModel,
 };
 use hil_envs::env::{PretrainReward, pretraining_data};
-use hil_envs::{DatasetReplayEnv, FoodDataset, FoodSplit};
+use hil_envs::{FoodDataset, FoodSplit};
 use rayon::prelude::*;
 
 use crate::calibrate::End;
+use crate::components::{
+    ConfiguredChannel, ConfiguredEnvironment, DatasetReplay, EpisodeSpec, PerfectExpertChannel,
+    SharedChannelFactory, SharedEnvironmentFactory, check_matches_task,
+};
 use crate::method::{GridPoint, Method, paper_policy};
 use crate::results::Reproduction;
 use serde::{Deserialize, Serialize};
@@ -124,6 +133,18 @@ pub struct ProtocolSettings {
     pub cross_w_task: f64,
     /// What the figures show.
     pub figures: FigureSettings,
+    /// What answers the policies' queries: a query-channel table (`type =
+    /// "..."`, any built-in, plugin or Python-registered type, and its
+    /// parameters); none: the paper's perfect expert
+    /// ([`crate::components`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub channel: Option<toml::Table>,
+    /// What presents the food items: an environment table (any registered
+    /// type) given the phase's `foods`, `items_per_episode` and `dataset`
+    /// by the protocol ([`ConfiguredEnvironment`]); none: the paper's
+    /// dataset replay over the phase's foods.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub environment: Option<toml::Table>,
 }
 
 impl ProtocolSettings {
@@ -187,6 +208,8 @@ impl ProtocolSettings {
                     "LinUCB-QG".into(),
                 ],
             },
+            channel: None,
+            environment: None,
         }
     }
 
@@ -221,6 +244,8 @@ impl ProtocolSettings {
         if let Some(d) = &mut s.dataset {
             *d = base.join(&*d);
         }
+        s.check_components()
+            .map_err(|e| hil_core::ConfigError::from_error(&text, path, &[], e))?;
         for m in &mut s.models {
             if let Some(f) = &mut m.file {
                 *f = base.join(&*f);
@@ -252,13 +277,33 @@ impl ProtocolSettings {
         }
     }
 
-    /// The workload models the settings name, loaded.
+    /// The workload models the settings name, loaded (a `config` model is
+    /// built with the settings' seed).
     pub fn load_models(&self) -> Result<Vec<NamedModel>> {
+        let ctx = BuildContext::new(".", self.seed);
         self.models
             .iter()
             .enumerate()
-            .map(|(i, m)| m.load(i))
+            .map(|(i, m)| m.load_with(i, &ctx))
             .collect()
+    }
+
+    /// The channel factory the settings name: their `channel` table's type,
+    /// or the paper's perfect expert.
+    pub fn channel_factory(&self) -> Result<SharedChannelFactory> {
+        Ok(match &self.channel {
+            Some(t) => Arc::new(ConfiguredChannel::new(t.clone())?),
+            None => Arc::new(PerfectExpertChannel),
+        })
+    }
+
+    /// The environment factory the settings name: their `environment`
+    /// table's type, or the paper's dataset replay.
+    pub fn environment_factory(&self) -> Result<SharedEnvironmentFactory> {
+        Ok(match &self.environment {
+            Some(t) => Arc::new(ConfiguredEnvironment::new(t.clone())?),
+            None => Arc::new(DatasetReplay),
+        })
     }
 
     /// The name of the paper's model whose published rows `model` is
@@ -364,6 +409,7 @@ impl ProtocolSettings {
                 }
             }
         }
+        self.check_components()?;
         for label in std::iter::once(&self.figures.rollout).chain(&self.figures.workload) {
             if self.method(label).is_none() {
                 return Err(HilError::invalid_parameter(
@@ -371,6 +417,19 @@ impl ProtocolSettings {
                     label,
                     "no method has that label",
                 ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that the `channel` and `environment` tables name known types
+    /// with valid parameters (the environment's for both phases).
+    pub fn check_components(&self) -> Result<()> {
+        self.channel_factory()?;
+        if let Some(t) = &self.environment {
+            let env = ConfiguredEnvironment::new(t.clone())?;
+            for foods in [&self.split.validation, &self.split.test] {
+                env.config(foods, self.items_per_episode, self.dataset.as_deref())?;
             }
         }
         Ok(())
@@ -403,8 +462,9 @@ impl ProtocolSettings {
     }
 }
 
-/// Where a protocol's workload model comes from: a bundled model or a
-/// model file, and the name it is reported under.
+/// Where a protocol's workload model comes from: a bundled model, a model
+/// file or a workload-model table of any registered type (built-in, plugin
+/// or registered from Python), and the name it is reported under.
 ///
 /// ```toml
 /// [[models]]
@@ -415,8 +475,12 @@ impl ProtocolSettings {
 /// name = "ours"
 /// file = "models/our_model.json"   # relative to the settings file
 /// paper = "f2_sim"                  # compare with the paper's f2_sim rows
+///
+/// [[models]]
+/// name = "plugin"
+/// config = { type = "my_model", rate = 0.2 }   # any registered type
 /// ```
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSource {
     /// The name tables and cross settings use.
@@ -427,6 +491,10 @@ pub struct ModelSource {
     /// A model JSON file (`hil workload fit` or `select` writes them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub file: Option<PathBuf>,
+    /// A workload-model table (`type = "..."` and its parameters; paths in
+    /// it resolve against the working directory).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub config: Option<toml::Table>,
     /// The paper's model (`f1_sim`, `f2_sim`, `f12_sim`) whose published
     /// rows this one is shown beside; default: `name`, and for a bundled
     /// `_steep` variant the model it brackets.
@@ -442,6 +510,7 @@ impl ModelSource {
             name: name.into(),
             bundled: Some(name.into()),
             file: None,
+            config: None,
             paper: match End::split(name) {
                 (base, End::Steep) => Some(base.to_string()),
                 (_, End::Lean) => None,
@@ -449,16 +518,46 @@ impl ModelSource {
         }
     }
 
-    /// Loads the model; `index` locates errors (`models[i]`).
+    /// A model of a registered type under `name` (`table`: `type = "..."`
+    /// and its parameters).
+    pub fn configured(name: &str, table: toml::Table) -> Self {
+        Self {
+            name: name.into(),
+            bundled: None,
+            file: None,
+            config: Some(table),
+            paper: None,
+        }
+    }
+
+    /// Loads the model with seed 0; `index` locates errors (`models[i]`).
     pub fn load(&self, index: usize) -> Result<NamedModel> {
-        let model: Arc<dyn WorkloadModel> = match (&self.bundled, &self.file) {
-            (Some(b), None) => hil_workload::bundled::load(b)?,
-            (None, Some(f)) => Arc::new(hil_workload::FittedModel::load(f)?),
+        self.load_with(index, &BuildContext::new(".", 0))
+    }
+
+    /// Loads the model, building a `config` model with `ctx`; `index`
+    /// locates errors (`models[i]`).
+    pub fn load_with(&self, index: usize, ctx: &BuildContext) -> Result<NamedModel> {
+        let model: Arc<dyn WorkloadModel> = match (&self.bundled, &self.file, &self.config) {
+            (Some(b), None, None) => hil_workload::bundled::load(b)?,
+            (None, Some(f), None) => Arc::new(hil_workload::FittedModel::load(f)?),
+            (None, None, Some(t)) => {
+                let invalid = |why: String| {
+                    HilError::invalid_parameter(format!("models[{index}].config"), &self.name, why)
+                };
+                let config = hil_core::plugin::component::<_, dyn WorkloadModelConfig>(
+                    toml::Value::Table(t.clone()),
+                )
+                .map_err(|e: toml::de::Error| invalid(e.message().trim().to_string()))?;
+                config.validate().map_err(|e| invalid(e.to_string()))?;
+                config.build(ctx)?
+            }
             _ => {
                 return Err(HilError::invalid_parameter(
                     format!("models[{index}]"),
                     &self.name,
-                    "give exactly one of `bundled` (a bundled model's name) or `file` (a model JSON file)",
+                    "give exactly one of `bundled` (a bundled model's name), `file` (a model \
+                     JSON file) or `config` (a workload-model table of any registered type)",
                 ));
             }
         };
@@ -564,9 +663,12 @@ pub struct Protocol {
     pub dataset: Arc<FoodDataset>,
     /// Workload models (decision and scoring).
     pub models: Vec<NamedModel>,
-    /// Builds the simulated expert for every episode (the paper's: a
+    /// Builds the simulated expert of every episode (the paper's: a
     /// perfect expert answering with the best action).
-    pub channel: fn() -> Box<dyn QueryChannel>,
+    pub channel: SharedChannelFactory,
+    /// Builds the environment of every episode (the paper's: dataset
+    /// replay over the phase's foods).
+    pub environment: SharedEnvironmentFactory,
 }
 
 impl std::fmt::Debug for Protocol {
@@ -575,28 +677,44 @@ impl std::fmt::Debug for Protocol {
             .field("settings", &self.settings)
             .field("dataset", &self.dataset.name)
             .field("models", &self.models)
+            .field("channel", &self.channel.name())
+            .field("environment", &self.environment.name())
             .finish()
     }
 }
 
-/// The paper's simulated expert for [`Protocol::channel`].
-pub fn perfect_expert() -> Box<dyn QueryChannel> {
-    Box::new(hil_core::PerfectExpert::default())
+/// How [`Protocol::run_until_cancelled`] ended.
+#[derive(Debug)]
+pub enum RunOutcome {
+    /// Every job ran: the records, in job order.
+    Finished(Vec<RunRecord>),
+    /// The cancel flag was raised; jobs already started finished, no others
+    /// started, and their records are dropped.
+    Cancelled {
+        /// Jobs finished before the run stopped.
+        done: usize,
+        /// Jobs the protocol has.
+        total: usize,
+    },
 }
 
 impl Protocol {
-    /// The paper's protocol over `dataset` and `models`, with its perfect expert.
+    /// The protocol over `dataset` and `models`, with the channel and
+    /// environment the settings name (by default the paper's perfect
+    /// expert and dataset replay). A settings table that does not name a
+    /// known type fails here, by field.
     pub fn new(
         settings: ProtocolSettings,
         dataset: Arc<FoodDataset>,
         models: Vec<NamedModel>,
-    ) -> Self {
-        Self {
+    ) -> Result<Self> {
+        Ok(Self {
+            channel: settings.channel_factory()?,
+            environment: settings.environment_factory()?,
             settings,
             dataset,
             models,
-            channel: perfect_expert,
-        }
+        })
     }
 
     /// The protocol over the dataset and workload models `settings` name
@@ -605,7 +723,21 @@ impl Protocol {
         let dataset = settings.load_dataset()?;
         let models = settings.load_models()?;
         settings.validate(&dataset, &models)?;
-        Ok(Self::new(settings, dataset, models))
+        Self::new(settings, dataset, models)
+    }
+
+    /// The same protocol with its episodes' query channels built by
+    /// `factory` (instead of what the settings name).
+    pub fn with_channel(mut self, factory: SharedChannelFactory) -> Self {
+        self.channel = factory;
+        self
+    }
+
+    /// The same protocol with its episodes' environments built by
+    /// `factory` (instead of what the settings name).
+    pub fn with_environment(mut self, factory: SharedEnvironmentFactory) -> Self {
+        self.environment = factory;
+        self
     }
 
     /// Selection, aggregation and the frontier of this protocol's `records`
@@ -690,6 +822,39 @@ impl Protocol {
         (label, seeds)
     }
 
+    /// `e`, raised by run `key`, naming the run: a component's failure
+    /// (a backend or query channel, e.g. a Python component's exception)
+    /// keeps its kind and source; anything else becomes a protocol state
+    /// error.
+    fn in_run(&self, key: &RunKey, e: HilError) -> HilError {
+        let m = &self.settings.methods[key.method];
+        let run = format!(
+            "run of `{}` {:?} ({:?}, seed {}, policy seed {})",
+            m.label, key.point, key.phase, key.seed, key.policy_seed
+        );
+        match e {
+            HilError::Backend {
+                backend,
+                why,
+                source,
+            } => HilError::Backend {
+                backend,
+                why: format!("{why} (in the {run})"),
+                source,
+            },
+            HilError::Channel {
+                channel,
+                why,
+                source,
+            } => HilError::Channel {
+                channel,
+                why: format!("{why} (in the {run})"),
+                source,
+            },
+            e => HilError::state("protocol", format!("{run} failed: {e}")),
+        }
+    }
+
     /// Runs one episode.
     pub fn run_one(&self, key: &RunKey, ctx: &TaskContext) -> Result<RunRecord> {
         let s = &self.settings;
@@ -700,16 +865,24 @@ impl Protocol {
         let method = s.methods.get(key.method).ok_or_else(|| {
             HilError::invalid_parameter("method", key.method, "no method at that index")
         })?;
-        let mut env = DatasetReplayEnv::new(self.dataset.clone(), foods, s.items_per_episode)?;
+        let (label, seeds) = self.seeds(key);
+        let mut env = self.environment.build(&EpisodeSpec {
+            dataset: &self.dataset,
+            dataset_path: s.dataset.as_deref(),
+            phase: key.phase,
+            foods,
+            items_per_episode: s.items_per_episode,
+            seed: seeds.environment,
+        })?;
+        check_matches_task(env.as_ref(), ctx, &self.environment.name())?;
         let mut policy = method.config(&key.point)?.build(ctx)?;
-        let mut channel = (self.channel)();
+        let mut channel = self.channel.build(ctx)?;
         // Methods that ignore the forecast are scored with the first model;
         // the tables rescore every run under each model anyway.
         let model = self.models[key.decide_model.unwrap_or(0)].model.clone();
-        let (label, seeds) = self.seeds(key);
         let mut session = Session::new(
             s.session.clone(),
-            &mut env,
+            env.as_mut(),
             policy.as_mut(),
             channel.as_mut(),
             model,
@@ -743,6 +916,21 @@ impl Protocol {
     /// the records in job order. The first failing run's error is returned,
     /// naming the run.
     pub fn run_all(&self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Vec<RunRecord>> {
+        match self.run_until_cancelled(progress, &AtomicBool::new(false))? {
+            RunOutcome::Finished(records) => Ok(records),
+            RunOutcome::Cancelled { .. } => unreachable!("nothing raises this cancel flag"),
+        }
+    }
+
+    /// [`Protocol::run_all`] that stops early once `cancel` is raised (e.g.
+    /// by a Ctrl-C handler on another thread): every job checks the flag
+    /// before it starts, so the run ends within one episode per worker
+    /// thread, as [`RunOutcome::Cancelled`].
+    pub fn run_until_cancelled(
+        &self,
+        progress: &(dyn Fn(usize, usize) + Sync),
+        cancel: &AtomicBool,
+    ) -> Result<RunOutcome> {
         self.settings.validate(&self.dataset, &self.models)?;
         let jobs = self.jobs()?;
         let ctx = self.build_context()?;
@@ -763,21 +951,24 @@ impl Protocol {
         }
         let total = jobs.len();
         let done = AtomicUsize::new(0);
-        jobs.par_iter()
+        // `None`: cancelled (rayon stops handing out jobs at the first).
+        let records: Option<Result<Vec<RunRecord>>> = jobs
+            .par_iter()
             .map(|key| {
-                let r = self.run_one(key, &ctx).map_err(|e| {
-                    let m = &self.settings.methods[key.method];
-                    HilError::state(
-                        "protocol",
-                        format!(
-                            "run of `{}` {:?} ({:?}, seed {}, policy seed {}) failed: {e}",
-                            m.label, key.point, key.phase, key.seed, key.policy_seed
-                        ),
-                    )
-                });
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let r = self.run_one(key, &ctx).map_err(|e| self.in_run(key, e));
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-                r
+                Some(r)
             })
-            .collect()
+            .collect();
+        match records {
+            Some(r) => Ok(RunOutcome::Finished(r?)),
+            None => Ok(RunOutcome::Cancelled {
+                done: done.into_inner(),
+                total,
+            }),
+        }
     }
 }

@@ -77,8 +77,18 @@ fn base_facts(ctx: &BuildContext) -> impl FnOnce(&Bound<'_, PyDict>) -> PyResult
     move |kw| kw.set_item("seed", ctx.seed)
 }
 
+/// Bumped by every registration, so a cache of built components (the
+/// sweep's protocol) can tell when a name's factory may have changed.
+static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// How many registrations this process has made.
+pub(crate) fn generation() -> u64 {
+    GENERATION.load(std::sync::atomic::Ordering::SeqCst)
+}
+
 /// Registers `factory` as the hil component type `name` of `kind`.
 pub(crate) fn register_factory(kind: ComponentKind, name: &str, factory: Py<PyAny>) -> Result<()> {
+    GENERATION.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
     {
         let mut all = FACTORIES.lock().unwrap_or_else(|e| e.into_inner());
         all.retain(|(k, n, _)| !(*k == kind && n == name));
@@ -133,14 +143,24 @@ impl hil_core::WorkloadModel for ArcWorkload {
     }
 }
 
+/// The names `register` takes for the four kinds.
+const KINDS: [(&str, ComponentKind); 4] = [
+    ("policy", ComponentKind::Policy),
+    ("environment", ComponentKind::Environment),
+    ("workload_model", ComponentKind::WorkloadModel),
+    ("query_channel", ComponentKind::QueryChannel),
+];
+
+/// The name `register` takes for `kind`.
+pub(crate) fn kind_name(kind: ComponentKind) -> &'static str {
+    KINDS
+        .iter()
+        .find(|(_, k)| *k == kind)
+        .map_or("policy", |(n, _)| n)
+}
+
 fn kind_of(kind: &str) -> Result<ComponentKind> {
-    let kinds: HashMap<&str, ComponentKind> = [
-        ("policy", ComponentKind::Policy),
-        ("environment", ComponentKind::Environment),
-        ("workload_model", ComponentKind::WorkloadModel),
-        ("query_channel", ComponentKind::QueryChannel),
-    ]
-    .into();
+    let kinds: HashMap<&str, ComponentKind> = KINDS.into();
     kinds.get(kind).copied().ok_or_else(|| {
         HilError::invalid_parameter(
             "kind",

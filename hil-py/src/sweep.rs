@@ -12,9 +12,12 @@ use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 use hil_core::{ExperimentConfig, HilError, TaskContext};
-use hil_experiments::testbed::{RunKey, RunRecord};
+use hil_experiments::testbed::{RunKey, RunOutcome, RunRecord};
 use hil_experiments::{Protocol, ProtocolSettings};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::reproduce::PythonComponents;
 
 use crate::errors::to_py_err;
 
@@ -32,14 +35,18 @@ struct Built {
     ctx: TaskContext,
 }
 
-/// The protocol a process last built, by its settings' JSON: a worker that
-/// runs many jobs of one sweep loads the dataset and models once.
-static LAST: Mutex<Option<(String, Arc<Built>)>> = Mutex::new(None);
+/// The protocol a process last built, by its settings' JSON and the
+/// Python registry's generation (a re-registered Python component may be
+/// another one under the same name): a worker that runs many jobs of one
+/// sweep loads the dataset and models once.
+static LAST: Mutex<Option<(String, u64, Arc<Built>)>> = Mutex::new(None);
 
 fn built(settings_json: &str) -> PyResult<Arc<Built>> {
+    let generation = crate::registry::generation();
     if let Ok(last) = LAST.lock()
-        && let Some((json, b)) = last.as_ref()
+        && let Some((json, g, b)) = last.as_ref()
         && json == settings_json
+        && *g == generation
     {
         return Ok(b.clone());
     }
@@ -48,7 +55,7 @@ fn built(settings_json: &str) -> PyResult<Arc<Built>> {
     let ctx = protocol.build_context().map_err(to_py_err)?;
     let b = Arc::new(Built { protocol, ctx });
     if let Ok(mut last) = LAST.lock() {
-        *last = Some((settings_json.to_string(), b.clone()));
+        *last = Some((settings_json.to_string(), generation, b.clone()));
     }
     Ok(b)
 }
@@ -105,15 +112,57 @@ fn protocol_run_json(py: Python<'_>, settings_json: &str, keys_json: &str) -> Py
 }
 
 /// Runs every job in this process with all its cores
-/// (`Protocol::run_all`), returning the records as a JSON array in job
-/// order.
+/// (`Protocol::run_until_cancelled`), returning the records as a JSON array
+/// in job order. Ctrl-C stops it (`KeyboardInterrupt`); `progress` is None,
+/// a callable `progress(done, total)` or `True` (a line on stderr).
 #[pyfunction]
-fn protocol_run_all_json(py: Python<'_>, settings_json: &str) -> PyResult<String> {
-    let records = py.detach(|| -> PyResult<Vec<RunRecord>> {
+#[pyo3(signature = (settings_json, progress = None))]
+fn protocol_run_all_json(
+    py: Python<'_>,
+    settings_json: &str,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<String> {
+    let outcome = crate::interruptible::run(py, progress, "hil.sweep", |control| {
         let b = built(settings_json)?;
-        b.protocol.run_all(&|_, _| {}).map_err(to_py_err)
+        b.protocol
+            .run_until_cancelled(&|done, total| control.report(done, total), &control.cancel)
+            .map_err(to_py_err)
     })?;
-    to_json("run records", &records)
+    match outcome? {
+        RunOutcome::Finished(records) => to_json("run records", &records),
+        RunOutcome::Cancelled { done, total } => Err(crate::reproduce::cancelled((done, total))),
+    }
+}
+
+/// A registration as Python sees it: `(kind, type name, factory)`, the
+/// arguments of `hil.register`.
+type RegistrationTuple = (&'static str, String, Py<PyAny>);
+
+/// The settings `settings_json` with the Python components added (as
+/// `hil.reproduce` takes them), and the registrations a Ray worker must
+/// repeat before running jobs: `(settings_json, [(kind, name, factory)])`.
+#[pyfunction]
+#[pyo3(signature = (settings_json, *, extra_methods = None, channel = None, environment = None, workload_models = None))]
+fn protocol_with_components(
+    settings_json: &str,
+    extra_methods: Option<&Bound<'_, PyDict>>,
+    channel: Option<&Bound<'_, PyAny>>,
+    environment: Option<&Bound<'_, PyAny>>,
+    workload_models: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(String, Vec<RegistrationTuple>)> {
+    let mut settings: ProtocolSettings = from_json("protocol settings", settings_json)?;
+    let regs = PythonComponents {
+        extra_methods,
+        channel,
+        environment,
+        workload_models,
+    }
+    .add_to(&mut settings)?;
+    let regs = regs
+        .into_iter()
+        .map(|r| (crate::registry::kind_name(r.kind), r.name, r.factory))
+        .collect();
+    Ok((to_json("protocol settings", &settings)?, regs))
 }
 
 /// The protocol's selection, aggregation and frontier of `records_json`
@@ -160,6 +209,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(protocol_jobs_json, m)?)?;
     m.add_function(wrap_pyfunction!(protocol_run_json, m)?)?;
     m.add_function(wrap_pyfunction!(protocol_run_all_json, m)?)?;
+    m.add_function(wrap_pyfunction!(protocol_with_components, m)?)?;
     m.add_function(wrap_pyfunction!(protocol_reproduction_json, m)?)?;
     m.add_function(wrap_pyfunction!(experiment_run_json, m)?)?;
     Ok(())

@@ -1,6 +1,7 @@
 //! The integration tests of `hil-experiments`, linked into one test binary (one
 //! link instead of one per file); each module was a file of its own.
 
+mod protocol_components;
 mod testbed;
 #[cfg(feature = "physics")]
 mod user_study;

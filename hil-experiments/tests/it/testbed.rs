@@ -11,7 +11,7 @@ use hil_experiments::results::{Reproduction, Spread, aggregate};
 use hil_experiments::testbed::{CrossSetting, Phase, RunKey, RunRecord};
 use hil_experiments::{NamedModel, Protocol, ProtocolSettings};
 
-fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
+pub fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
     let ds = Arc::new(
         SyntheticFoods {
             dim: 224,
@@ -64,7 +64,7 @@ fn run_all(p: &Protocol, threads: usize) -> Vec<RunRecord> {
 #[test]
 fn protocol_runs_selects_on_validation_and_is_deterministic() {
     let (ds, settings, models) = setup();
-    let p = Protocol::new(settings.clone(), ds.clone(), models.clone());
+    let p = Protocol::new(settings.clone(), ds.clone(), models.clone()).unwrap();
     // What each method needs comes from its config: 2 phases × 3 seeds ×
     // (LinUCB + AQ + 2 c × 3 policy seeds + 3 w × 2 deciding models).
     assert_eq!(p.jobs().unwrap().len(), 2 * 3 * (1 + 1 + 6 + 6));
@@ -166,7 +166,7 @@ fn bad_settings_are_errors_that_name_the_field() {
         test: vec![],
         ..FoodSplit::paper()
     };
-    let p = Protocol::new(settings, ds.clone(), models.clone());
+    let p = Protocol::new(settings, ds.clone(), models.clone()).unwrap();
     let e = p.run_all(&|_, _| {}).unwrap_err().to_string();
     assert!(e.contains("split.test"), "{e}");
 
@@ -193,6 +193,7 @@ fn bad_settings_are_errors_that_name_the_field() {
     let (ds, mut settings, models) = setup();
     settings.methods[3].tune.insert("w".into(), vec![1.0, -1.0]);
     let e = Protocol::new(settings, ds, models)
+        .unwrap()
         .run_all(&|_, _| {})
         .unwrap_err();
     assert!(
@@ -205,7 +206,7 @@ fn bad_settings_are_errors_that_name_the_field() {
 #[test]
 fn plots_render_runs() {
     let (ds, settings, models) = setup();
-    let p = Protocol::new(settings, ds, models.clone());
+    let p = Protocol::new(settings, ds, models.clone()).unwrap();
     let ctx = p.build_context().unwrap();
     let rec = p
         .run_one(
@@ -244,11 +245,11 @@ fn the_many_seed_run_contains_the_paper_protocol_run() {
     settings.cross.clear();
     settings.figures.rollout = "LinUCB".into();
     settings.figures.workload = vec!["AlwaysQuery".into()];
-    let alone = Protocol::new(settings.clone(), ds.clone(), models.clone());
+    let alone = Protocol::new(settings.clone(), ds.clone(), models.clone()).unwrap();
     let alone = Reproduction::of(&settings, &models, &run_all(&alone, 2), "t").unwrap();
     assert!(alone.many_seeds.is_none());
     settings.many_seeds = 6;
-    let p = Protocol::new(settings.clone(), ds, models.clone());
+    let p = Protocol::new(settings.clone(), ds, models.clone()).unwrap();
     assert_eq!(p.jobs().unwrap().len(), 2 * 6 * 2);
     let both = Reproduction::of(&settings, &models, &run_all(&p, 2), "t").unwrap();
     let many = both.many_seeds.as_ref().unwrap();
@@ -302,7 +303,8 @@ fn a_testbed_episode_and_an_experiment_file_episode_score_alike() {
             name: "f2_sim".into(),
             model: f2,
         }],
-    );
+    )
+    .unwrap();
     let key = RunKey {
         phase: Phase::Test,
         method: 3,

@@ -267,15 +267,23 @@ def run_session(
     resume: Optional[_Path] = None,
     events: bool = False,
 ) -> Dict[str, Any]: ...
+# A Python component for the protocol: a factory (class or function), a
+# (factory, params) tuple, or a dict naming a registered type.
+_ComponentSpec = Union[Callable[..., Any], Tuple[Callable[..., Any], Mapping[str, Any]], Mapping[str, Any]]
+
 def reproduce(
     settings: Union[None, _Path, Mapping[str, Any]] = None,
     *,
     quick: bool = False,
     seed: Optional[int] = None,
     many_seeds: Optional[int] = None,
-    extra_methods: Optional[Mapping[str, Union[Callable[..., Any], Tuple[Callable[..., Any], Mapping[str, Any]]]]] = None,
+    extra_methods: Optional[Mapping[str, _ComponentSpec]] = None,
+    channel: Optional[_ComponentSpec] = None,
+    environment: Optional[_ComponentSpec] = None,
+    workload_models: Optional[Mapping[str, Any]] = None,
     out: Optional[_Path] = None,
     records: bool = False,
+    progress: Union[None, bool, Callable[[int, int], Any]] = None,
 ) -> Dict[str, Any]: ...
 
 # --- conformance suites (hil.testing) --------------------------------------------
@@ -354,7 +362,17 @@ def protocol_preset_json(name: str) -> str: ...
 def protocol_settings_from_file(path: str) -> str: ...
 def protocol_jobs_json(settings_json: str) -> str: ...
 def protocol_run_json(settings_json: str, keys_json: str) -> str: ...
-def protocol_run_all_json(settings_json: str) -> str: ...
+def protocol_run_all_json(
+    settings_json: str, progress: Union[None, bool, Callable[[int, int], Any]] = None
+) -> str: ...
+def protocol_with_components(
+    settings_json: str,
+    *,
+    extra_methods: Optional[Mapping[str, Any]] = None,
+    channel: Any = None,
+    environment: Any = None,
+    workload_models: Optional[Mapping[str, Any]] = None,
+) -> Tuple[str, List[Tuple[str, str, Any]]]: ...
 def protocol_reproduction_json(settings_json: str, records_json: str) -> str: ...
 def experiment_run_json(
     config_toml: str, seed: int, name: str = "experiment.toml", base_dir: str = "."

@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 from . import _hil
 
@@ -82,7 +82,11 @@ def _chunks(items: Sequence[Any], n: int) -> list[list[Any]]:
     return [list(items[i : i + size]) for i in range(0, len(items), size)]
 
 
-def _protocol_chunk(settings_json: str, keys_json: str) -> str:
+def _protocol_chunk(settings_json: str, keys_json: str, registrations: list) -> str:
+    # A Ray worker is another process: register the Python components the
+    # settings name (as the caller did) before building the protocol.
+    for kind, name, factory in registrations:
+        _hil.register(kind, name, factory)
     return _hil.protocol_run_json(settings_json, keys_json)
 
 
@@ -107,6 +111,11 @@ def sweep(
     address: Optional[str] = None,
     num_cpus: Optional[int] = None,
     tasks_per_cpu: int = 4,
+    extra_methods: Optional[dict] = None,
+    channel: Any = None,
+    environment: Any = None,
+    workload_models: Optional[dict] = None,
+    progress: Union[None, bool, Callable[[int, int], Any]] = None,
 ) -> Any:
     """Runs the paper's protocol, or experiment configs x seeds, on Ray.
 
@@ -128,6 +137,21 @@ def sweep(
         num_cpus: CPUs of a local Ray.
         tasks_per_cpu: how many Ray tasks per CPU the protocol's jobs are
             cut into (more balances better, fewer costs less overhead).
+        extra_methods, channel, environment, workload_models: Python
+            components joining the protocol, exactly as :func:`hil.reproduce`
+            takes them. In process they always work. On Ray each task
+            registers them again in its worker, so they must pickle
+            (cloudpickle: classes and functions defined in a module the
+            workers can import, or in ``__main__``); a dict naming a
+            registered Rust type needs nothing.
+        progress: ``True`` for a line on stderr, or a callable
+            ``progress(done, total)`` called in this process as runs (in
+            process) or Ray tasks (on Ray) finish; for configs, as config
+            runs finish.
+
+    Ctrl-C (``KeyboardInterrupt``) stops an in-process protocol sweep
+    within about one episode per thread; on Ray it cancels the pending
+    tasks.
 
     Returns:
         For a protocol, ``{"settings": dict, "records": [RunRecord...],
@@ -147,16 +171,43 @@ def sweep(
     if protocol is not None:
         if seeds is not None:
             raise ValueError("seeds go with configs; a protocol's seeds are in its settings")
-        return _sweep_protocol(protocol_settings(protocol), ray, tasks_per_cpu)
+        components = dict(
+            extra_methods=extra_methods,
+            channel=channel,
+            environment=environment,
+            workload_models=workload_models,
+        )
+        return _sweep_protocol(
+            protocol_settings(protocol), components, ray, tasks_per_cpu, progress
+        )
+    if any(c is not None for c in (extra_methods, channel, environment, workload_models)):
+        raise ValueError("Python components go with a protocol, not with configs")
     if seeds is None:
         raise ValueError("configs need seeds")
-    return _sweep_configs(configs, list(seeds), ray)
+    return _sweep_configs(configs, list(seeds), ray, progress)
 
 
-def _sweep_protocol(settings: dict, ray, tasks_per_cpu: int) -> dict:
-    settings_json = json.dumps(settings)
+def _reporter(progress, what: str):
+    """A ``report(done, total)`` for Python-side loops (None if no progress)."""
+    if progress is None or progress is False:
+        return None
+    if callable(progress):
+        return progress
+
+    def report(done: int, total: int) -> None:
+        end = "\n" if done == total else ""
+        print(f"\r{what}: {done}/{total} {end}", end="", file=__import__("sys").stderr, flush=True)
+
+    return report
+
+
+def _sweep_protocol(settings: dict, components: dict, ray, tasks_per_cpu: int, progress) -> dict:
+    settings_json, registrations = _hil.protocol_with_components(
+        json.dumps(settings), **components
+    )
+    settings = json.loads(settings_json)
     if ray is None:
-        records_json = _hil.protocol_run_all_json(settings_json)
+        records_json = _hil.protocol_run_all_json(settings_json, progress)
         records = json.loads(records_json)
     else:
         keys = json.loads(_hil.protocol_jobs_json(settings_json))
@@ -164,23 +215,44 @@ def _sweep_protocol(settings: dict, ray, tasks_per_cpu: int) -> dict:
         remote = ray.remote(num_cpus=1)(_protocol_chunk)
         settings_ref = ray.put(settings_json)
         futures = [
-            remote.remote(settings_ref, json.dumps(chunk))
+            remote.remote(settings_ref, json.dumps(chunk), registrations)
             for chunk in _chunks(keys, cpus * max(1, tasks_per_cpu))
         ]
-        records = [r for chunk in ray.get(futures) for r in json.loads(chunk)]
+        chunks = _ray_results(ray, futures, _reporter(progress, "hil.sweep tasks"))
+        records = [r for chunk in chunks for r in json.loads(chunk)]
         records_json = json.dumps(records)
     reproduction = json.loads(_hil.protocol_reproduction_json(settings_json, records_json))
     return {"settings": settings, "records": records, "reproduction": reproduction}
 
 
-def _sweep_configs(configs, seeds: list[int], ray) -> list[dict]:
+def _ray_results(ray, futures: list, report) -> list:
+    """``ray.get(futures)``, reporting finished tasks; Ctrl-C cancels the rest."""
+    try:
+        pending = list(futures)
+        while pending:
+            _, pending = ray.wait(pending, num_returns=1)
+            if report is not None:
+                report(len(futures) - len(pending), len(futures))
+        return ray.get(futures)
+    except KeyboardInterrupt:
+        for f in futures:
+            ray.cancel(f)
+        raise
+
+
+def _sweep_configs(configs, seeds: list[int], ray, progress) -> list[dict]:
     grid = [(i, _read_config(c), s) for i, c in enumerate(configs) for s in seeds]
+    report = _reporter(progress, "hil.sweep runs")
     if ray is None:
-        summaries = [_experiment_job(text, s, name, base) for _, (text, name, base), s in grid]
+        summaries = []
+        for _, (text, name, base), s in grid:
+            summaries.append(_experiment_job(text, s, name, base))
+            if report is not None:
+                report(len(summaries), len(grid))
     else:
         remote = ray.remote(num_cpus=1)(_experiment_job)
-        summaries = ray.get(
-            [remote.remote(text, s, name, base) for _, (text, name, base), s in grid]
+        summaries = _ray_results(
+            ray, [remote.remote(text, s, name, base) for _, (text, name, base), s in grid], report
         )
     return [
         {"config": i, "seed": s, "summary": json.loads(summary)}

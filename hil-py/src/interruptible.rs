@@ -1,0 +1,132 @@
+//! Long runs that Ctrl-C stops and that report progress: the work runs on a
+//! scoped thread with the GIL released, while the calling thread wakes
+//! every [`POLL`] to report progress and to let Python run its signal
+//! handlers. A `KeyboardInterrupt` (or any exception the progress callback
+//! raises) raises the work's cancel flag, waits for the work to stop, and
+//! is then raised to the caller.
+//!
+//! Self-contained on purpose: any long call (`hil.reproduce`, the
+//! in-process `hil.sweep`) wraps its work in [`run`].
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Duration;
+
+use pyo3::prelude::*;
+
+/// How often the caller's thread wakes to check signals and report.
+const POLL: Duration = Duration::from_millis(50);
+
+/// What the work and the polling thread share.
+#[derive(Debug, Default)]
+pub(crate) struct Control {
+    /// Raised when the caller wants the work to stop.
+    pub(crate) cancel: AtomicBool,
+    done: AtomicUsize,
+    total: AtomicUsize,
+}
+
+impl Control {
+    /// Records that `done` of `total` units are finished.
+    pub(crate) fn report(&self, done: usize, total: usize) {
+        self.total.store(total, Ordering::Relaxed);
+        self.done.fetch_max(done, Ordering::Relaxed);
+    }
+
+    fn progress(&self) -> (usize, usize) {
+        (
+            self.done.load(Ordering::Relaxed),
+            self.total.load(Ordering::Relaxed),
+        )
+    }
+}
+
+/// Where progress goes: a callable `progress(done, total)`, or `True` for a
+/// line on `sys.stderr` (rewritten in place).
+enum Sink<'py> {
+    Call(Bound<'py, PyAny>),
+    Stderr(&'static str),
+}
+
+impl Sink<'_> {
+    fn of<'py>(progress: Option<&Bound<'py, PyAny>>, what: &'static str) -> Option<Sink<'py>> {
+        let p = progress?;
+        if p.is_none() {
+            return None;
+        }
+        if p.is_callable() {
+            return Some(Sink::Call(p.clone()));
+        }
+        p.is_truthy().ok()?.then_some(Sink::Stderr(what))
+    }
+
+    fn send(&self, py: Python<'_>, (done, total): (usize, usize), last: bool) -> PyResult<()> {
+        match self {
+            Sink::Call(f) => f.call1((done, total)).map(drop),
+            Sink::Stderr(what) => {
+                let end = if last { "\n" } else { "" };
+                let err = py.import("sys")?.getattr("stderr")?;
+                err.call_method1("write", (format!("\r{what}: {done}/{total} runs{end}"),))?;
+                err.call_method0("flush").map(drop)
+            }
+        }
+    }
+}
+
+/// Runs `work` with the GIL released on a scoped thread, reporting its
+/// progress (`progress`: None, a callable `f(done, total)`, or `True` for a
+/// line on stderr naming `what`) and stopping it on Ctrl-C. `work` must
+/// check [`Control::cancel`] often and call [`Control::report`]. Returns
+/// what `work` returned, or the Python exception (`KeyboardInterrupt`, or
+/// one the progress callback raised) after the work has stopped.
+pub(crate) fn run<T: Send>(
+    py: Python<'_>,
+    progress: Option<&Bound<'_, PyAny>>,
+    what: &'static str,
+    work: impl FnOnce(&Control) -> T + Send,
+) -> PyResult<T> {
+    let sink = Sink::of(progress, what);
+    let control = Control::default();
+    std::thread::scope(|scope| {
+        let handle = scope.spawn(|| work(&control));
+        let mut reported = (0, 0);
+        let mut raised = None;
+        loop {
+            let finished = py.detach(|| {
+                let until = std::time::Instant::now() + POLL;
+                while !handle.is_finished() && std::time::Instant::now() < until {
+                    std::thread::sleep(Duration::from_millis(5));
+                }
+                handle.is_finished()
+            });
+            let now = control.progress();
+            if let Some(sink) = &sink
+                && now != reported
+                && now.1 > 0
+            {
+                reported = now;
+                if let Err(e) = sink.send(py, now, finished && now.0 == now.1) {
+                    raised = Some(e);
+                }
+            }
+            if raised.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                raised = Some(e);
+            }
+            if raised.is_some() {
+                control.cancel.store(true, Ordering::Relaxed);
+            }
+            if finished || raised.is_some() {
+                break;
+            }
+        }
+        let out = py.detach(|| handle.join());
+        match (raised, out) {
+            (Some(e), _) => Err(e),
+            (None, Ok(v)) => Ok(v),
+            (None, Err(_)) => Err(pyo3::exceptions::PyRuntimeError::new_err(format!(
+                "{what}: the run panicked (a bug in hil; please report it)"
+            ))),
+        }
+    })
+}

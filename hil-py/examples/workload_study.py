@@ -74,9 +74,9 @@ def main(argv=None) -> dict:
         done = False
         while not done:
             t = info["t"]
-            action = qg.act(env.core)
+            action = env.act(qg)
             obs, reward, done, _, info = env.step(action)
-            qg.learn(env.core)  # it keeps learning across episodes
+            env.learn(qg)  # it keeps learning across episodes
             # The workload trace after the step's last attempt.
             ts.append(t + len(info["executed_arms"]) - 1)
             wls.append(info["wl_t"])

@@ -38,13 +38,15 @@ pub(crate) fn json_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
     json.call_method1("dumps", (obj,))?.extract()
 }
 
-/// A context from a 1-d float array (or anything NumPy converts to one).
-pub(crate) fn context(array: PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
-    let values: Vec<f64> = match array.as_slice() {
-        Ok(s) => s.to_vec(),
-        Err(_) => array.as_array().iter().copied().collect(),
-    };
-    Context::new(values).py_err()
+/// A context from a 1-d float array: one copy, straight into the
+/// context's shared buffer when the array is contiguous (hil's policies may
+/// keep a context, so it cannot borrow NumPy's memory), checked once.
+pub(crate) fn context(array: &PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
+    match array.as_slice() {
+        Ok(values) => Context::new(values),
+        Err(_) => Context::new(array.as_array().iter().copied().collect::<Vec<f64>>()),
+    }
+    .py_err()
 }
 
 /// A context as a new 1-d float array.

@@ -11,6 +11,7 @@
 //! - [`pycomponents`]: Python objects serving as those four traits;
 //! - [`registry`]: Python factories as named component types;
 //! - [`session`]: the session loop with its record and resume;
+//! - [`interrupt`]: long work that Ctrl-C stops;
 //! - [`reproduce`]: the paper's simulated protocol;
 //! - [`workload`]: the study loader, fitting and model selection;
 //! - [`testing`]: the conformance suites.
@@ -21,6 +22,7 @@ mod components;
 mod convert;
 mod errors;
 mod gym;
+mod interrupt;
 mod pycomponents;
 mod registry;
 mod reproduce;

@@ -357,7 +357,7 @@ impl PyPolicyHandle {
 
     /// Learns from executing `arm` in `context` with `reward` at `t`
     /// (`from_expert`: the arm was the person's answer).
-    #[pyo3(signature = (context, arm, reward, t=1, *, from_expert=false))]
+    #[pyo3(signature = (context, arm, reward, t=1, from_expert=false))]
     fn observe(
         &self,
         py: Python<'_>,

@@ -150,15 +150,16 @@ def make_numpy(w: Workload):
 
 
 def time_steps(w: Workload, decide: Callable, observe: Callable, steps: int, n_arms: int = ARMS,
-               native=None, inner_out: Optional[list] = None):
+               native=None, inner_out: Optional[list] = None, first_t: int = 1):
     """Per-step seconds of ``decide(x, t)`` + ``observe(x, arm, reward, t,
-    from_expert)`` (the reward draw not timed).
+    from_expert)`` (the reward draw not timed), at timesteps ``first_t``,
+    ``first_t + 1``, ... (two warm-up steps first).
 
     With ``native`` (a ``hil.Policy``), the seconds spent inside the
     policy at each step (``inner_seconds``) are appended to ``inner_out``.
     """
     out, inner = [], []
-    for t in range(1, steps + 3):  # two warm-up steps
+    for t in range(first_t, first_t + steps + 2):
         x = w.contexts(1)[0]
         before = native.inner_seconds if native is not None else 0.0
         t0 = time.perf_counter()
@@ -212,11 +213,12 @@ def main(argv: Optional[list[str]] = None) -> dict:
         for lib in libs:
             w = Workload(seed=rep, d=args.dim, per_arm=args.per_arm)
             decide, observe, native = makers[lib](w)
-            probe = time_steps(w, decide, observe, 2)
+            probe = time_steps(w, decide, observe, 2)  # timesteps 1 to 4
             steps = args.steps if statistics.fmean(probe) < 0.02 else args.slow_steps
             steps_used[lib] = steps
             inner: list[float] = []
-            times = time_steps(w, decide, observe, steps, native=native, inner_out=inner)
+            times = time_steps(w, decide, observe, steps, native=native, inner_out=inner,
+                               first_t=5)
             per_repeat[lib].append(statistics.fmean(times))
             medians[lib].append(statistics.median(times))
             if native is not None:

@@ -2,7 +2,7 @@
 //! (JSON), so that every result shape has one definition: the Rust type's.
 
 use hil_core::{Context, HilError};
-use numpy::{PyArray1, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
 use serde::Serialize;
@@ -38,13 +38,21 @@ pub(crate) fn json_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
     json.call_method1("dumps", (obj,))?.extract()
 }
 
-/// A context from a 1-d float array: one copy, straight into the
-/// context's shared buffer when the array is contiguous (hil's policies may
-/// keep a context, so it cannot borrow NumPy's memory), checked once.
-pub(crate) fn context(array: &PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
-    match array.as_slice() {
+/// A context from a 1-d float64 array: one copy, straight into the
+/// context's shared buffer (hil's policies may keep a context, so it cannot
+/// borrow NumPy's memory), checked once by `Context::new`.
+///
+/// The array is read without rust-numpy's borrow tracking (a
+/// `PyReadonlyArray`), which costs more than the copy itself on a call whose
+/// caches are cold (hil-py/README.md, "Crossing into Rust").
+pub(crate) fn context(array: &Bound<'_, PyArray1<f64>>) -> PyResult<Context> {
+    // SAFETY: the values are copied at once with the GIL held and no
+    // reference into NumPy's memory outlives this call: the reasoning of
+    // rust-numpy's own safe `to_vec`, which reads through `as_slice` too.
+    match unsafe { array.as_slice() } {
         Ok(values) => Context::new(values),
-        Err(_) => Context::new(array.as_array().iter().copied().collect::<Vec<f64>>()),
+        // Not contiguous (a strided view): gather the entries first.
+        Err(_) => Context::new(array.to_owned_array().iter().copied().collect::<Vec<f64>>()),
     }
     .py_err()
 }

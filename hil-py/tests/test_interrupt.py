@@ -76,6 +76,8 @@ delay = {DELAY}
 [workload]
 type = "bundled"
 name = "f2_sim"
+[channel]
+type = "simulated_expert"
 """
 
 

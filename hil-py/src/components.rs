@@ -145,6 +145,9 @@ impl PolicyState {
 #[pyclass(module = "hil._hil", name = "Policy", frozen)]
 pub(crate) struct PyPolicyHandle {
     pub(crate) inner: Arc<Mutex<PolicyState>>,
+    /// The buffer the last context from Python was copied into, reused by
+    /// the next call when nothing kept it (see [`PyPolicyHandle::context`]).
+    scratch: Mutex<Option<Arc<[f64]>>>,
     name: String,
     n_arms: usize,
     dim: usize,
@@ -170,7 +173,34 @@ impl PyPolicyHandle {
                 history: QueryHistory::new(),
                 inner: Duration::ZERO,
             })),
+            scratch: Mutex::new(None),
         })
+    }
+
+    /// `array` as a context, copied into the buffer of the previous call
+    /// when no one kept that one (a policy may keep a context; hil's copy
+    /// what they learn): after a large policy's sweep has evicted the
+    /// caches, allocating and freeing 16 KB costs a few tenths of a
+    /// microsecond (hil-py/README.md, "Crossing into Rust"). The buffer's
+    /// lock is only ever held for this copy; a call that finds it taken (by
+    /// another thread) allocates instead of waiting.
+    fn context(&self, array: &Bound<'_, PyArray1<f64>>) -> PyResult<Context> {
+        let Ok(mut slot) = self.scratch.try_lock() else {
+            return crate::convert::context(array);
+        };
+        let reused = slot
+            .as_mut()
+            .and_then(Arc::get_mut)
+            .filter(|buf| buf.len() == numpy::PyUntypedArrayMethods::len(array))
+            .is_some_and(|buf| crate::convert::copy_context(array, buf));
+        match slot.clone() {
+            Some(values) if reused => Context::new(values).py_err(),
+            _ => {
+                let values = crate::convert::values(array);
+                *slot = Some(values.clone());
+                Context::new(values).py_err()
+            }
+        }
     }
 
     /// The policy and its own state, locked.
@@ -317,7 +347,7 @@ impl PyPolicyHandle {
         wl0: Option<f64>,
         query_times: Option<Vec<u64>>,
     ) -> PyResult<Py<PyAny>> {
-        let x = crate::convert::context(context)?;
+        let x = self.context(context)?;
         let given = query_times.map(|q| history_of(&q)).transpose()?;
         let model = workload.map(|w| w.get().inner.clone());
         let decision: Decision = py
@@ -350,7 +380,7 @@ impl PyPolicyHandle {
         items_seen: usize,
         attempt: u32,
     ) -> PyResult<usize> {
-        let x = crate::convert::context(context)?;
+        let x = self.context(context)?;
         let work = || self.state().act(&x, t, (item_index, items_seen, attempt));
         heavy(py, self.dim, work).py_err()
     }
@@ -367,7 +397,7 @@ impl PyPolicyHandle {
         t: u64,
         from_expert: bool,
     ) -> PyResult<()> {
-        let x = crate::convert::context(context)?;
+        let x = self.context(context)?;
         let feedback = Feedback::new(&x, ArmId(arm), reward, t).from_expert(from_expert);
         heavy(py, self.dim, || self.state().observe(&feedback)).py_err()
     }

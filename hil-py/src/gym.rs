@@ -14,7 +14,6 @@
 //! or dropping the environment) disconnects the remote, whose next `decide`
 //! fails, which ends the worker's session.
 
-use std::path::Path;
 use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
@@ -642,83 +641,8 @@ fn paper_food_split_json() -> PyResult<String> {
         .map_err(|e| to_py_err(HilError::serde("the paper's food split", e)))
 }
 
-// --- Study helpers for hil.envs' example (`examples/workload_study.py`):
-// the smallest native surface that loads a study, selects and fits a
-// workload model, in the same steps as `hil workload select` / `fit`.
-
-/// Cross-validates every candidate workload model on D1, D2 and D12 of the
-/// study CSV at `path` (`hil workload select`), returning the selection
-/// table as JSON (`rows`, each with `dataset`, `candidate`, the test MSEs
-/// and their `median`). `histories` are the Granger history lengths tried
-/// (None: hil's default grid, 1 to 30); `threads` = 0 uses every core.
-#[pyfunction]
-#[pyo3(signature = (path, histories = None, threads = 0, seed = 0))]
-fn study_select_json(
-    py: Python<'_>,
-    path: &str,
-    histories: Option<Vec<usize>>,
-    threads: usize,
-    seed: u64,
-) -> PyResult<String> {
-    use hil_workload::datasets::{Dataset, DatasetId};
-    use hil_workload::select::{Candidate, SelectOptions, cross_validate};
-    py.detach(|| -> hil_core::Result<String> {
-        let study = hil_workload::study::Study::load(Path::new(path))?;
-        let sets: Vec<Dataset> = DatasetId::ALL
-            .iter()
-            .map(|&id| Dataset::build(&study, id))
-            .collect::<hil_core::Result<_>>()?;
-        let refs: Vec<&Dataset> = sets.iter().collect();
-        let defaults = SelectOptions::default();
-        let opts = SelectOptions {
-            histories: histories.unwrap_or(defaults.histories.clone()),
-            seed,
-            threads,
-            ..defaults
-        };
-        let table = cross_validate(&refs, &Candidate::table(&opts.histories), &opts)?;
-        Ok(table.to_json())
-    })
-    .map_err(to_py_err)
-}
-
-/// Fits `candidate_json` (a `candidate` of [`study_select_json`]'s rows,
-/// e.g. `{"family": "exp_impulse"}`) on the `population` dataset (`d1`,
-/// `d2`, `d12`) of the study CSV at `path` (as `hil workload fit` does),
-/// returning the model file's JSON, which a `{"type": "model_file",
-/// "path": ...}` workload table loads.
-#[pyfunction]
-#[pyo3(signature = (path, population, candidate_json, seed = 0))]
-fn study_fit_json(
-    py: Python<'_>,
-    path: &str,
-    population: &str,
-    candidate_json: &str,
-    seed: u64,
-) -> PyResult<String> {
-    use hil_workload::datasets::DatasetId;
-    use hil_workload::models::FittedModel;
-    use hil_workload::select::{Candidate, SelectOptions, fit_study_model};
-    let cand: Candidate = parse_json("workload candidate", candidate_json).map_err(to_py_err)?;
-    let fitted = py
-        .detach(|| -> hil_core::Result<FittedModel> {
-            let study = hil_workload::study::Study::load(Path::new(path))?;
-            let id = DatasetId::parse(population)?;
-            let opts = SelectOptions {
-                seed,
-                ..SelectOptions::default()
-            };
-            fit_study_model(&study, id, cand, &opts, None)
-        })
-        .map_err(to_py_err)?;
-    serde_json::to_string_pretty(&fitted)
-        .map_err(|e| to_py_err(HilError::serde("fitted workload model", e)))
-}
-
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<GymCore>()?;
     m.add_function(wrap_pyfunction!(paper_food_split_json, m)?)?;
-    m.add_function(wrap_pyfunction!(study_select_json, m)?)?;
-    m.add_function(wrap_pyfunction!(study_fit_json, m)?)?;
     Ok(())
 }

@@ -207,6 +207,23 @@ impl PyPolicyHandle {
     pub(crate) fn state(&self) -> MutexGuard<'_, PolicyState> {
         self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
+
+    /// Runs `f` on the locked state. `light` work (small, or no policy call
+    /// at all) keeps the GIL, since releasing and retaking it costs about as
+    /// much as a small policy's whole call, unless another thread holds the
+    /// state: that one (a session sharing this policy) may be waiting for
+    /// the GIL, so this one waits for the lock without it.
+    fn with_state<T: Send>(
+        &self,
+        py: Python<'_>,
+        light: bool,
+        f: impl FnOnce(&mut PolicyState) -> T + Send,
+    ) -> T {
+        if light && let Ok(mut state) = self.inner.try_lock() {
+            return f(&mut state);
+        }
+        py.detach(|| f(&mut self.state()))
+    }
 }
 /// The build context of a policy or channel from the Python arguments.
 pub(crate) fn task_context(
@@ -321,8 +338,8 @@ impl PyPolicyHandle {
     }
 
     /// Reseeds the policy's own randomness.
-    fn seed(&self, seed: u64) {
-        self.state().policy.seed(seed);
+    fn seed(&self, py: Python<'_>, seed: u64) {
+        self.with_state(py, true, |s| s.policy.seed(seed));
     }
 
     /// Decides for `context` (1-d float array) at timestep `t`: returns the
@@ -381,8 +398,11 @@ impl PyPolicyHandle {
         attempt: u32,
     ) -> PyResult<usize> {
         let x = self.context(context)?;
-        let work = || self.state().act(&x, t, (item_index, items_seen, attempt));
-        heavy(py, self.dim, work).py_err()
+        let light = self.dim < DETACH_MIN_DIM;
+        self.with_state(py, light, |s| {
+            s.act(&x, t, (item_index, items_seen, attempt))
+        })
+        .py_err()
     }
 
     /// Learns from executing `arm` in `context` with `reward` at `t`
@@ -399,18 +419,22 @@ impl PyPolicyHandle {
     ) -> PyResult<()> {
         let x = self.context(context)?;
         let feedback = Feedback::new(&x, ArmId(arm), reward, t).from_expert(from_expert);
-        heavy(py, self.dim, || self.state().observe(&feedback)).py_err()
+        let light = self.dim < DETACH_MIN_DIM;
+        self.with_state(py, light, |s| s.observe(&feedback))
+            .py_err()
     }
 
     /// The times of the queries the policy asked through `act`.
     #[getter]
-    fn query_times(&self) -> Vec<u64> {
-        self.state().history.records().iter().map(|r| r.t).collect()
+    fn query_times(&self, py: Python<'_>) -> Vec<u64> {
+        self.with_state(py, true, |s| {
+            s.history.records().iter().map(|r| r.t).collect()
+        })
     }
 
     /// Forgets the queries asked through `act` (a new episode's person).
-    fn clear_queries(&self) {
-        self.state().history = QueryHistory::new();
+    fn clear_queries(&self, py: Python<'_>) {
+        self.with_state(py, true, |s| s.history = QueryHistory::new());
     }
 
     /// Seconds spent inside the policy's own `decide` and `observe` so far,
@@ -418,8 +442,8 @@ impl PyPolicyHandle {
     /// Gymnasium environment): what `hil bench policy` times, so that the
     /// rest of a call's time is the cost of crossing from Python.
     #[getter]
-    fn inner_seconds(&self) -> f64 {
-        self.state().inner.as_secs_f64()
+    fn inner_seconds(&self, py: Python<'_>) -> f64 {
+        self.with_state(py, true, |s| s.inner.as_secs_f64())
     }
 
     /// The full learning state as a JSON string (estimates, RNG, counters).
@@ -467,19 +491,8 @@ impl PyPolicyHandle {
     }
 }
 
-/// Runs `work` for a policy of context dimension `dim`, releasing the GIL
-/// only when the work is heavy enough to pay for it: releasing and taking
-/// the GIL back costs about as much as a small policy's whole call.
-fn heavy<T: Send>(py: Python<'_>, dim: usize, work: impl FnOnce() -> T + Send) -> T {
-    if dim >= DETACH_MIN_DIM {
-        py.detach(work)
-    } else {
-        work()
-    }
-}
-
 /// The context dimension from which a policy call releases the GIL (see
-/// [`heavy`]): LinUCB-QG's decide + observe take ~2 µs at d = 16 and
+/// [`PyPolicyHandle::with_state`]): LinUCB-QG's decide + observe take ~2 µs at d = 16 and
 /// ~5-15 µs at d = 128 (300 pretraining rows per arm), releasing and
 /// retaking the GIL ~0.1-0.3 µs (hil-py/README.md, "Crossing into Rust").
 const DETACH_MIN_DIM: usize = 128;

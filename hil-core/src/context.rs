@@ -32,7 +32,12 @@ impl Context {
                 "it has no entries (dimension 0)",
             ));
         }
-        if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        // One pass without an early exit, which the compiler vectorises
+        // (this runs on every context crossing from Python); the offending
+        // entry is looked for only when there is one.
+        let all_finite = values.iter().fold(true, |ok, v| ok & v.is_finite());
+        if !all_finite && let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite())
+        {
             return Err(HilError::invalid_input(
                 format!("context[{i}]"),
                 format!("{v} is not finite"),

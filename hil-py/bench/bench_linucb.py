@@ -17,10 +17,12 @@ times with fresh data (different seeds) and the table gives the mean and
 standard error over repeats of the per-repeat means.
 
 For hil, the time spent inside the policy (Rust ``decide`` + ``observe``,
-measured in Rust around the calls) is subtracted from the time measured in
-Python around the same calls, step by step: the median of that difference
-over a repeat's steps is the per-step cost of crossing from Python into
-Rust (the call, the context's conversion and check, the GIL release).
+measured in Rust around exactly the calls ``hil bench policy`` times) is
+subtracted from the time measured in Python around the same calls
+(``hil.Policy.act`` and ``observe``, called directly), step by step: the
+median of that difference over a repeat's steps is the per-step cost of
+crossing from Python into Rust (the call and its arguments, the context's
+copy and check, the GIL release and the lock).
 
 Run (release build of hil, bench packages installed)::
 
@@ -98,23 +100,13 @@ class NumpySM:
 
 
 def make_hil(w: Workload, policy: dict):
-    import hil._hil as native
+    """hil's policy as a ``hil.Policy``; its bound ``act`` and ``observe``
+    are timed directly, so the crossing figure holds no Python wrapper."""
+    import hil
 
-    x, a, r = w.pretrain
-    p = native.NativePolicy(
-        json.dumps(policy), ARMS, w.d, json.dumps({"type": "bundled", "name": "f12_sim"}),
-        0.5, x, a.tolist(), r.tolist(),
-    )
-    state = {"t": 0}
-
-    def decide(ctx: np.ndarray) -> int:
-        state["t"] += 1
-        return p.decide(ctx, state["t"])
-
-    def observe(ctx: np.ndarray, arm: int, reward: float, expert: bool) -> None:
-        p.observe(ctx, arm, reward, state["t"], expert)
-
-    return decide, observe, p
+    p = hil.Policy(policy.pop("type"), actions=ARMS, dim=w.d, pretraining=w.pretrain,
+                   forecast="f12_sim", wl0=0.5, **policy)
+    return p.act, p.observe, p
 
 
 def make_mabwiser(w: Workload):
@@ -124,10 +116,10 @@ def make_mabwiser(w: Workload):
     mab = MAB(arms=list(range(ARMS)), learning_policy=LearningPolicy.LinUCB(alpha=ALPHA, l2_lambda=1.0), seed=0)
     mab.fit(decisions=a, rewards=r, contexts=x)
 
-    def decide(ctx: np.ndarray) -> int:
+    def decide(ctx: np.ndarray, t: int) -> int:
         return int(mab.predict(contexts=ctx[None, :]))
 
-    def observe(ctx: np.ndarray, arm: int, reward: float, expert: bool) -> None:
+    def observe(ctx: np.ndarray, arm: int, reward: float, t: int, expert: bool) -> None:
         mab.partial_fit(decisions=[arm], rewards=[reward], contexts=ctx[None, :])
 
     return decide, observe, None
@@ -141,10 +133,10 @@ def make_contextualbandits(w: Workload):
                random_state=1)
     m.fit(x, a, r)
 
-    def decide(ctx: np.ndarray) -> int:
+    def decide(ctx: np.ndarray, t: int) -> int:
         return int(m.predict(ctx[None, :])[0])
 
-    def observe(ctx: np.ndarray, arm: int, reward: float, expert: bool) -> None:
+    def observe(ctx: np.ndarray, arm: int, reward: float, t: int, expert: bool) -> None:
         m.partial_fit(ctx[None, :], np.array([arm]), np.array([reward]))
 
     return decide, observe, None
@@ -153,29 +145,32 @@ def make_contextualbandits(w: Workload):
 def make_numpy(w: Workload):
     m = NumpySM(w.d, ARMS, ALPHA)
     m.fit(*w.pretrain)
-    return m.decide, (lambda ctx, arm, reward, expert: m.observe(ctx, arm, reward)), None
+    return ((lambda ctx, t: m.decide(ctx)),
+            (lambda ctx, arm, reward, t, expert: m.observe(ctx, arm, reward)), None)
 
 
 def time_steps(w: Workload, decide: Callable, observe: Callable, steps: int, n_arms: int = ARMS,
-               native=None, inner_out: Optional[list] = None):
-    """Per-step seconds of decide + observe (the reward draw not timed).
+               native=None, inner_out: Optional[list] = None, first_t: int = 1):
+    """Per-step seconds of ``decide(x, t)`` + ``observe(x, arm, reward, t,
+    from_expert)`` (the reward draw not timed), at timesteps ``first_t``,
+    ``first_t + 1``, ... (two warm-up steps first).
 
-    With ``native`` (a hil NativePolicy), the seconds spent inside the
-    policy at each step are appended to ``inner_out``.
+    With ``native`` (a ``hil.Policy``), the seconds spent inside the
+    policy at each step (``inner_seconds``) are appended to ``inner_out``.
     """
     out, inner = [], []
-    for _ in range(steps + 2):  # two warm-up steps
+    for t in range(first_t, first_t + steps + 2):
         x = w.contexts(1)[0]
         before = native.inner_seconds if native is not None else 0.0
         t0 = time.perf_counter()
-        arm = decide(x)
+        arm = decide(x, t)
         t1 = time.perf_counter()
         expert = arm == n_arms  # hil's "ask": the expert answers
         if expert:
             arm = w.best(x)
         reward = w.reward(x, arm)
         t2 = time.perf_counter()
-        observe(x, arm, reward, expert)
+        observe(x, arm, reward, t, expert)
         t3 = time.perf_counter()
         out.append((t1 - t0) + (t3 - t2))
         if native is not None:
@@ -204,7 +199,7 @@ def main(argv: Optional[list[str]] = None) -> dict:
     args = ap.parse_args(argv)
     policy = {"type": "linucb_qg", "alpha": ALPHA, "w": 0.2, "pretrain": True}
     makers = {
-        "hil": lambda w: make_hil(w, policy),
+        "hil": lambda w: make_hil(w, dict(policy)),
         "numpy": make_numpy,
         "contextualbandits": make_contextualbandits,
         "mabwiser": make_mabwiser,
@@ -218,11 +213,12 @@ def main(argv: Optional[list[str]] = None) -> dict:
         for lib in libs:
             w = Workload(seed=rep, d=args.dim, per_arm=args.per_arm)
             decide, observe, native = makers[lib](w)
-            probe = time_steps(w, decide, observe, 2)
+            probe = time_steps(w, decide, observe, 2)  # timesteps 1 to 4
             steps = args.steps if statistics.fmean(probe) < 0.02 else args.slow_steps
             steps_used[lib] = steps
             inner: list[float] = []
-            times = time_steps(w, decide, observe, steps, native=native, inner_out=inner)
+            times = time_steps(w, decide, observe, steps, native=native, inner_out=inner,
+                               first_t=5)
             per_repeat[lib].append(statistics.fmean(times))
             medians[lib].append(statistics.median(times))
             if native is not None:

@@ -16,7 +16,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import tempfile
 from pathlib import Path
@@ -27,7 +26,7 @@ matplotlib.use("Agg")  # writes files; no display needed
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-import hil._hil as native  # noqa: E402
+import hil  # noqa: E402
 from hil.envs import FoodReplayEnv  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
@@ -52,14 +51,14 @@ def main(argv=None) -> dict:
 
     # %% 1-2. Select a workload model on the study and fit it on all of it.
     histories = [int(h) for h in args.histories.split(",") if h]
-    table = json.loads(native.study_select_json(str(args.study), histories))
+    study = hil.Study.load(args.study)
+    table = hil.select_workload(study, histories=histories)
     rows = [r for r in table["rows"] if r["dataset"] == args.population]
     best = min(rows, key=lambda r: r["median"])
     cand = best["candidate"]
     print(f"selected on {args.population.upper()}: {cand} (median test MSE {best['median']:.4f})")
-    model_json = native.study_fit_json(str(args.study), args.population, json.dumps(cand))
     model_file = Path(tempfile.mkdtemp()) / "workload_model.json"
-    model_file.write_text(model_json)
+    model = hil.fit_workload(study, population=args.population, model=cand, out=model_file)
 
     # %% 3. LinUCB-QG in the Gymnasium environment, with that model.
     env = FoodReplayEnv(
@@ -74,9 +73,9 @@ def main(argv=None) -> dict:
         done = False
         while not done:
             t = info["t"]
-            action = qg.act(env.core)
+            action = env.act(qg)
             obs, reward, done, _, info = env.step(action)
-            qg.learn(env.core)  # it keeps learning across episodes
+            env.learn(qg)  # it keeps learning across episodes
             # The workload trace after the step's last attempt.
             ts.append(t + len(info["executed_arms"]) - 1)
             wls.append(info["wl_t"])
@@ -104,8 +103,7 @@ def main(argv=None) -> dict:
     ax.set_xlabel("timestep t (10 s)")
     ax.set_ylabel("workload WL_t")
     ax.set_ylim(0, 1)
-    name = json.loads(model_json)["name"]
-    ax.set_title(f"LinUCB-QG under {name} (selected and fitted on {args.population.upper()})"
+    ax.set_title(f"LinUCB-QG under {model.name} (selected and fitted on {args.population.upper()})"
                  "\nsynthetic data, not the paper's", fontsize="medium")
     ax.legend(fontsize="small", ncol=2)
     fig.tight_layout()

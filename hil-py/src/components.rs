@@ -7,12 +7,14 @@
 
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
 
 use hil_core::config::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Context, Decision, DecisionInput, Environment, Feedback,
-    HilError, Item, LabelledObservation, Outcome, Policy, Query, QueryChannel, QueryHistory,
-    QueryKind, Response, Result, TaskContext, WorkloadForecast, WorkloadInput, WorkloadModel,
+    ActionSpace, ArmId, BuildContext, Choice, Context, Decision, DecisionInput, Environment,
+    Feedback, HilError, Item, LabelledObservation, Outcome, Policy, Query, QueryChannel,
+    QueryHistory, QueryKind, Response, Result, TaskContext, Timestep, WorkloadForecast,
+    WorkloadInput, WorkloadModel,
 };
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -77,6 +79,58 @@ fn lock<T: ?Sized>(m: &Mutex<Box<T>>) -> MutexGuard<'_, Box<T>> {
 
 // ---------------------------------------------------------------- policies
 
+/// A built policy with what it needs to decide on its own: the workload
+/// model its forecasts use, WL_0, the queries it asked through `act`, and
+/// the time spent inside its `decide` and `observe`.
+pub(crate) struct PolicyState {
+    policy: Box<dyn Policy>,
+    forecast: Option<Arc<dyn WorkloadModel>>,
+    wl0: f64,
+    history: QueryHistory,
+    inner: Duration,
+}
+
+impl PolicyState {
+    /// The policy's `decide`, timed.
+    pub(crate) fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
+        let start = Instant::now();
+        let decision = self.policy.decide(input);
+        self.inner += start.elapsed();
+        decision
+    }
+
+    /// The policy's `observe`, timed.
+    pub(crate) fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()> {
+        let start = Instant::now();
+        let learnt = self.policy.observe(feedback);
+        self.inner += start.elapsed();
+        learnt
+    }
+
+    /// Decides for `context` at `t` with its own forecast and query
+    /// history, adding the query it asks (if any) to that history; returns
+    /// the arm, or `n_arms` for "ask".
+    fn act(&mut self, context: &Context, t: Timestep, at: (usize, usize, u32)) -> Result<usize> {
+        let history = std::mem::take(&mut self.history);
+        let forecast = self.forecast.clone();
+        let input = DecisionInput::new(
+            context,
+            t,
+            WorkloadForecast::new(forecast.as_deref(), self.wl0, &history, t),
+        )
+        .at_item(at.0, at.1, at.2);
+        let decision = self.decide(&input);
+        self.history = history;
+        Ok(match decision?.choice {
+            Choice::Act { arm } => arm.0,
+            Choice::Query { kind, .. } => {
+                self.history.push(t, kind)?;
+                self.policy.n_arms()
+            }
+        })
+    }
+}
+
 /// A hil policy (any built-in or registered type).
 ///
 /// Built from its type and hyperparameters, validated: e.g.
@@ -84,26 +138,93 @@ fn lock<T: ?Sized>(m: &Mutex<Box<T>>) -> MutexGuard<'_, Box<T>> {
 /// raise `InvalidParameterError` naming the parameter. The environment's
 /// facts come from `environment=` (which also gives pretraining data when
 /// `pretrain=True`), or from `actions=` (a count or names) and `dim=`
-/// (with `pretraining=(X, arms, rewards)` arrays if wanted).
-#[pyclass(module = "hil._hil", name = "Policy")]
+/// (with `pretraining=(X, arms, rewards)` arrays if wanted). `forecast=`
+/// (a `WorkloadModel`) and `wl0=` are what its own decisions forecast
+/// workload with (`act`, and `decide` without `workload=`); the Gymnasium
+/// environments hand out policies so set up (`HilEnv.policy`).
+#[pyclass(module = "hil._hil", name = "Policy", frozen)]
 pub(crate) struct PyPolicyHandle {
-    pub(crate) inner: Arc<Mutex<Box<dyn Policy>>>,
+    pub(crate) inner: Arc<Mutex<PolicyState>>,
+    /// The buffer the last context from Python was copied into, reused by
+    /// the next call when nothing kept it (see [`PyPolicyHandle::context`]).
+    scratch: Mutex<Option<Arc<[f64]>>>,
     name: String,
     n_arms: usize,
     dim: usize,
 }
 
 impl PyPolicyHandle {
-    fn new(policy: Box<dyn Policy>) -> Self {
-        Self {
+    /// A handle on `policy`, whose own decisions forecast workload with
+    /// `forecast` from `wl0`.
+    pub(crate) fn new(
+        policy: Box<dyn Policy>,
+        forecast: Option<Arc<dyn WorkloadModel>>,
+        wl0: f64,
+    ) -> Result<Self> {
+        hil_core::workload::check_wl0(wl0)?;
+        Ok(Self {
             name: policy.name().to_string(),
             n_arms: policy.n_arms(),
             dim: policy.dim(),
-            inner: Arc::new(Mutex::new(policy)),
+            inner: Arc::new(Mutex::new(PolicyState {
+                policy,
+                forecast,
+                wl0,
+                history: QueryHistory::new(),
+                inner: Duration::ZERO,
+            })),
+            scratch: Mutex::new(None),
+        })
+    }
+
+    /// `array` as a context, copied into the buffer of the previous call
+    /// when no one kept that one (a policy may keep a context; hil's copy
+    /// what they learn): after a large policy's sweep has evicted the
+    /// caches, allocating and freeing 16 KB costs a few tenths of a
+    /// microsecond (hil-py/README.md, "Crossing into Rust"). The buffer's
+    /// lock is only ever held for this copy; a call that finds it taken (by
+    /// another thread) allocates instead of waiting.
+    fn context(&self, array: &Bound<'_, PyArray1<f64>>) -> PyResult<Context> {
+        let Ok(mut slot) = self.scratch.try_lock() else {
+            return crate::convert::context(array);
+        };
+        let reused = slot
+            .as_mut()
+            .and_then(Arc::get_mut)
+            .filter(|buf| buf.len() == numpy::PyUntypedArrayMethods::len(array))
+            .is_some_and(|buf| crate::convert::copy_context(array, buf));
+        match slot.clone() {
+            Some(values) if reused => Context::new(values).py_err(),
+            _ => {
+                let values = crate::convert::values(array);
+                *slot = Some(values.clone());
+                Context::new(values).py_err()
+            }
         }
     }
-}
 
+    /// The policy and its own state, locked.
+    pub(crate) fn state(&self) -> MutexGuard<'_, PolicyState> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Runs `f` on the locked state. `light` work (small, or no policy call
+    /// at all) keeps the GIL, since releasing and retaking it costs about as
+    /// much as a small policy's whole call, unless another thread holds the
+    /// state: that one (a session sharing this policy) may be waiting for
+    /// the GIL, so this one waits for the lock without it.
+    fn with_state<T: Send>(
+        &self,
+        py: Python<'_>,
+        light: bool,
+        f: impl FnOnce(&mut PolicyState) -> T + Send,
+    ) -> T {
+        if light && let Ok(mut state) = self.inner.try_lock() {
+            return f(&mut state);
+        }
+        py.detach(|| f(&mut self.state()))
+    }
+}
 /// The build context of a policy or channel from the Python arguments.
 pub(crate) fn task_context(
     py: Python<'_>,
@@ -177,7 +298,7 @@ pub(crate) fn task_context(
 #[pymethods]
 impl PyPolicyHandle {
     #[new]
-    #[pyo3(signature = (r#type, /, *, environment=None, actions=None, dim=None, pretraining=None, seed=0, **params))]
+    #[pyo3(signature = (r#type, /, *, environment=None, actions=None, dim=None, pretraining=None, seed=0, forecast=None, wl0=0.5, **params))]
     #[allow(clippy::too_many_arguments)]
     fn py_new(
         py: Python<'_>,
@@ -187,12 +308,15 @@ impl PyPolicyHandle {
         dim: Option<usize>,
         pretraining: Option<&Bound<'_, PyAny>>,
         seed: u64,
+        forecast: Option<&Bound<'_, PyAny>>,
+        wl0: f64,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         let cfg = policy_config(table(r#type, params)?).py_err()?;
         let ctx = task_context(py, environment, actions, dim, pretraining, seed)?;
+        let forecast = forecast.map(workload_arg).transpose()?;
         let policy = py.detach(|| cfg.build(&ctx)).py_err()?;
-        Ok(Self::new(policy))
+        Self::new(policy, forecast, wl0).py_err()
     }
 
     /// The policy's short name (e.g. `linucb_qg`).
@@ -201,80 +325,130 @@ impl PyPolicyHandle {
         &self.name
     }
 
-    /// Number of robot actions.
+    /// Number of robot actions; `act` returns this for "ask".
     #[getter]
-    fn n_arms(&self) -> usize {
+    pub(crate) fn n_arms(&self) -> usize {
         self.n_arms
     }
 
     /// Context dimension.
     #[getter]
-    fn dim(&self) -> usize {
+    pub(crate) fn dim(&self) -> usize {
         self.dim
     }
 
     /// Reseeds the policy's own randomness.
-    fn seed(&self, seed: u64) {
-        lock(&self.inner).seed(seed);
+    fn seed(&self, py: Python<'_>, seed: u64) {
+        self.with_state(py, true, |s| s.policy.seed(seed));
     }
 
     /// Decides for `context` (1-d float array) at timestep `t`: returns the
     /// `Decision` as a dict (`choice`: `{"type": "act", "arm": k}` or
     /// `{"type": "query", "kind": ..., "fallback": k}`; `diagnostics`).
-    /// `workload` (a `WorkloadModel`) backs the forecast that LinUCB-QG
-    /// weighs, with initial workload `wl0` and the times of the queries
-    /// asked so far (`query_times`).
-    #[pyo3(signature = (context, t=1, *, item_index=0, items_seen=0, attempt=0, workload=None, wl0=0.5, query_times=None))]
+    /// LinUCB-QG weighs the workload forecast by `workload` (a
+    /// `WorkloadModel`; default the policy's `forecast=`) from `wl0`
+    /// (default the policy's) given the queries asked at `query_times`
+    /// (default those it asked through `act`). Nothing is recorded: use
+    /// `act` for a policy that acts on its own.
+    #[pyo3(signature = (context, t=1, *, item_index=0, items_seen=0, attempt=0, workload=None, wl0=None, query_times=None))]
     #[allow(clippy::too_many_arguments)]
     fn decide(
         &self,
         py: Python<'_>,
-        context: PyReadonlyArray1<'_, f64>,
+        context: &Bound<'_, PyArray1<f64>>,
         t: u64,
         item_index: usize,
         items_seen: usize,
         attempt: u32,
         workload: Option<&Bound<'_, PyWorkloadHandle>>,
-        wl0: f64,
+        wl0: Option<f64>,
         query_times: Option<Vec<u64>>,
     ) -> PyResult<Py<PyAny>> {
-        let x = crate::convert::context(context)?;
-        let history = history_of(query_times.as_deref())?;
-        let model = workload.map(|w| w.borrow().inner.clone());
+        let x = self.context(context)?;
+        let given = query_times.map(|q| history_of(&q)).transpose()?;
+        let model = workload.map(|w| w.get().inner.clone());
         let decision: Decision = py
             .detach(|| {
+                let mut state = self.state();
+                let model = model.or_else(|| state.forecast.clone());
+                let wl0 = wl0.unwrap_or(state.wl0);
+                let history = given.unwrap_or_else(|| state.history.clone());
                 let forecast = WorkloadForecast::new(model.as_deref(), wl0, &history, t);
                 let input =
                     DecisionInput::new(&x, t, forecast).at_item(item_index, items_seen, attempt);
-                lock(&self.inner).decide(&input)
+                state.decide(&input)
             })
             .py_err()?;
         to_py(py, &decision, "decision")
     }
 
+    /// Decides for `context` at `t` as an agent on its own: returns the arm
+    /// to execute, or `n_arms` to ask (a Gymnasium agent's action). The
+    /// forecast is the policy's own (`forecast=`, `wl0=`, and the queries it
+    /// asked through `act`, to which an "ask" is added). The fast path: no
+    /// dict is built.
+    #[pyo3(signature = (context, t=1, *, item_index=0, items_seen=0, attempt=0))]
+    fn act(
+        &self,
+        py: Python<'_>,
+        context: &Bound<'_, PyArray1<f64>>,
+        t: u64,
+        item_index: usize,
+        items_seen: usize,
+        attempt: u32,
+    ) -> PyResult<usize> {
+        let x = self.context(context)?;
+        let light = self.dim < DETACH_MIN_DIM;
+        self.with_state(py, light, |s| {
+            s.act(&x, t, (item_index, items_seen, attempt))
+        })
+        .py_err()
+    }
+
     /// Learns from executing `arm` in `context` with `reward` at `t`
     /// (`from_expert`: the arm was the person's answer).
-    #[pyo3(signature = (context, arm, reward, t=1, *, from_expert=false))]
+    #[pyo3(signature = (context, arm, reward, t=1, from_expert=false))]
     fn observe(
         &self,
         py: Python<'_>,
-        context: PyReadonlyArray1<'_, f64>,
+        context: &Bound<'_, PyArray1<f64>>,
         arm: usize,
         reward: f64,
         t: u64,
         from_expert: bool,
     ) -> PyResult<()> {
-        let x = crate::convert::context(context)?;
-        py.detach(|| {
-            let f = Feedback::new(&x, ArmId(arm), reward, t).from_expert(from_expert);
-            lock(&self.inner).observe(&f)
+        let x = self.context(context)?;
+        let feedback = Feedback::new(&x, ArmId(arm), reward, t).from_expert(from_expert);
+        let light = self.dim < DETACH_MIN_DIM;
+        self.with_state(py, light, |s| s.observe(&feedback))
+            .py_err()
+    }
+
+    /// The times of the queries the policy asked through `act`.
+    #[getter]
+    fn query_times(&self, py: Python<'_>) -> Vec<u64> {
+        self.with_state(py, true, |s| {
+            s.history.records().iter().map(|r| r.t).collect()
         })
-        .py_err()
+    }
+
+    /// Forgets the queries asked through `act` (a new episode's person).
+    fn clear_queries(&self, py: Python<'_>) {
+        self.with_state(py, true, |s| s.history = QueryHistory::new());
+    }
+
+    /// Seconds spent inside the policy's own `decide` and `observe` so far,
+    /// whoever called them (`act`, `decide`, `observe`, a session, a
+    /// Gymnasium environment): what `hil bench policy` times, so that the
+    /// rest of a call's time is the cost of crossing from Python.
+    #[getter]
+    fn inner_seconds(&self, py: Python<'_>) -> f64 {
+        self.with_state(py, true, |s| s.inner.as_secs_f64())
     }
 
     /// The full learning state as a JSON string (estimates, RNG, counters).
     fn save(&self, py: Python<'_>) -> PyResult<String> {
-        let state = py.detach(|| lock(&self.inner).save()).py_err()?;
+        let state = py.detach(|| self.state().policy.save()).py_err()?;
         serde_json::to_string(&state)
             .map_err(|e| HilError::serde("policy state", e))
             .py_err()
@@ -288,21 +462,21 @@ impl PyPolicyHandle {
                 .py_err()?,
             Err(_) => from_py(state, "policy state")?,
         };
-        py.detach(|| lock(&self.inner).restore(value)).py_err()
+        py.detach(|| self.state().policy.restore(value)).py_err()
     }
 
     /// The diagnostics of a decision for `context` as a dict (per-arm
     /// estimate, bonus and UCB; gap, threshold, query probability and
     /// workload forecast where the policy computes them). It decides to
     /// get them, so a stochastic policy's random stream advances.
-    #[pyo3(signature = (context, t=1, *, workload=None, wl0=0.5, query_times=None))]
+    #[pyo3(signature = (context, t=1, *, workload=None, wl0=None, query_times=None))]
     fn diagnostics(
         &self,
         py: Python<'_>,
-        context: PyReadonlyArray1<'_, f64>,
+        context: &Bound<'_, PyArray1<f64>>,
         t: u64,
         workload: Option<&Bound<'_, PyWorkloadHandle>>,
-        wl0: f64,
+        wl0: Option<f64>,
         query_times: Option<Vec<u64>>,
     ) -> PyResult<Py<PyAny>> {
         let d = self.decide(py, context, t, 0, 0, 0, workload, wl0, query_times)?;
@@ -317,9 +491,15 @@ impl PyPolicyHandle {
     }
 }
 
-fn history_of(times: Option<&[u64]>) -> PyResult<QueryHistory> {
+/// The context dimension from which a policy call releases the GIL (see
+/// [`PyPolicyHandle::with_state`]): LinUCB-QG's decide + observe take ~2 µs at d = 16 and
+/// ~5-15 µs at d = 128 (300 pretraining rows per arm), releasing and
+/// retaking the GIL ~0.1-0.3 µs (hil-py/README.md, "Crossing into Rust").
+const DETACH_MIN_DIM: usize = 128;
+
+fn history_of(times: &[u64]) -> PyResult<QueryHistory> {
     let mut h = QueryHistory::new();
-    for &t in times.unwrap_or(&[]) {
+    for &t in times {
         h.push(t, QueryKind::default()).py_err()?;
     }
     Ok(h)
@@ -328,10 +508,16 @@ fn history_of(times: Option<&[u64]>) -> PyResult<QueryHistory> {
 /// A shared hil policy as a trait object: every call locks it, so the
 /// Python handle sees what the loop taught it.
 struct SharedPolicy {
-    inner: Arc<Mutex<Box<dyn Policy>>>,
+    inner: Arc<Mutex<PolicyState>>,
     name: String,
     n_arms: usize,
     dim: usize,
+}
+
+impl SharedPolicy {
+    fn state(&self) -> MutexGuard<'_, PolicyState> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
 }
 
 impl Policy for SharedPolicy {
@@ -345,19 +531,19 @@ impl Policy for SharedPolicy {
         self.dim
     }
     fn seed(&mut self, seed: u64) {
-        lock(&self.inner).seed(seed)
+        self.state().policy.seed(seed)
     }
     fn decide(&mut self, input: &DecisionInput<'_>) -> Result<Decision> {
-        lock(&self.inner).decide(input)
+        self.state().decide(input)
     }
     fn observe(&mut self, feedback: &Feedback<'_>) -> Result<()> {
-        lock(&self.inner).observe(feedback)
+        self.state().observe(feedback)
     }
     fn save(&self) -> Result<Value> {
-        lock(&self.inner).save()
+        self.state().policy.save()
     }
     fn restore(&mut self, state: Value) -> Result<()> {
-        lock(&self.inner).restore(state)
+        self.state().policy.restore(state)
     }
 }
 
@@ -365,7 +551,7 @@ impl Policy for SharedPolicy {
 /// policy methods.
 pub(crate) fn policy_arg(obj: &Bound<'_, PyAny>) -> PyResult<Box<dyn Policy>> {
     if let Ok(h) = obj.cast::<PyPolicyHandle>() {
-        let h = h.borrow();
+        let h = h.get();
         return Ok(Box::new(SharedPolicy {
             inner: h.inner.clone(),
             name: h.name.clone(),

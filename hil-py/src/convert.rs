@@ -1,8 +1,10 @@
 //! Rust values to plain Python data and back, through their serde form
 //! (JSON), so that every result shape has one definition: the Rust type's.
 
+use std::sync::Arc;
+
 use hil_core::{Context, HilError};
-use numpy::{PyArray1, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyModule;
 use serde::Serialize;
@@ -38,13 +40,40 @@ pub(crate) fn json_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
     json.call_method1("dumps", (obj,))?.extract()
 }
 
-/// A context from a 1-d float array (or anything NumPy converts to one).
-pub(crate) fn context(array: PyReadonlyArray1<'_, f64>) -> PyResult<Context> {
-    let values: Vec<f64> = match array.as_slice() {
-        Ok(s) => s.to_vec(),
-        Err(_) => array.as_array().iter().copied().collect(),
-    };
-    Context::new(values).py_err()
+/// A context from a 1-d float64 array: one copy, straight into the
+/// context's shared buffer (hil's policies may keep a context, so it cannot
+/// borrow NumPy's memory), checked once by `Context::new`.
+pub(crate) fn context(array: &Bound<'_, PyArray1<f64>>) -> PyResult<Context> {
+    Context::new(values(array)).py_err()
+}
+
+/// The entries of a 1-d float64 array in a new shared buffer (one copy).
+///
+/// The array is read without rust-numpy's borrow tracking (a
+/// `PyReadonlyArray`), which costs more than the copy itself on a call whose
+/// caches are cold (hil-py/README.md, "Crossing into Rust").
+pub(crate) fn values(array: &Bound<'_, PyArray1<f64>>) -> Arc<[f64]> {
+    // SAFETY: the values are copied at once with the GIL held and no
+    // reference into NumPy's memory outlives this call: the reasoning of
+    // rust-numpy's own safe `to_vec`, which reads through `as_slice` too.
+    match unsafe { array.as_slice() } {
+        Ok(values) => Arc::from(values),
+        // Not contiguous (a strided view): gather the entries.
+        Err(_) => array.to_owned_array().iter().copied().collect(),
+    }
+}
+
+/// Copies a contiguous `array` into `buf` (of its length); false if the
+/// array is not contiguous.
+pub(crate) fn copy_context(array: &Bound<'_, PyArray1<f64>>, buf: &mut [f64]) -> bool {
+    // SAFETY: as in `context`.
+    match unsafe { array.as_slice() } {
+        Ok(values) => {
+            buf.copy_from_slice(values);
+            true
+        }
+        Err(_) => false,
+    }
 }
 
 /// A context as a new 1-d float array.

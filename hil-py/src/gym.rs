@@ -1,5 +1,5 @@
 //! Native engine of `hil.envs`: hil's session loop driven one decision at a
-//! time by a Gymnasium agent, and a native policy to drive it with.
+//! time by a Gymnasium agent, which may be a `hil.Policy` (`act` / `learn`).
 //!
 //! A Gymnasium environment hands control to the agent at every step, while
 //! hil's [`Session`] owns its loop. Rather than re-implementing the loop
@@ -14,28 +14,26 @@
 //! or dropping the environment) disconnects the remote, whose next `decide`
 //! fails, which ends the worker's session.
 
-use std::path::Path;
 use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
 
 use hil_core::config::{
     EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig, check_session_limits,
 };
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Choice, Context, Decision, DecisionInput, Environment,
-    EpisodeReport, Feedback, HilError, LabelledObservation, Policy, QueryChannel, QueryHistory,
-    QueryKind, Session, SessionObserver, SessionSettings, StepEvent, TaskContext, Timestep,
-    WorkloadForecast, WorkloadModel,
+    ArmId, BuildContext, Choice, Context, Decision, DecisionInput, Environment, EpisodeReport,
+    Feedback, HilError, Policy, QueryChannel, QueryHistory, QueryKind, Session, SessionObserver,
+    SessionSettings, StepEvent, TaskContext, Timestep, WorkloadForecast, WorkloadModel,
 };
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde::Deserialize;
 
+use crate::components::PyPolicyHandle;
 use crate::errors::to_py_err;
 
 /// What the environment of a [`GymCore`] is made of (JSON from Python):
@@ -430,23 +428,86 @@ impl GymCore {
     /// A hil policy for this environment, from its config table as JSON
     /// (e.g. `{"type": "linucb_qg", "alpha": 0.5, "w": 4.0, "pretrain":
     /// true}`), built exactly as an experiment would build it (with the
-    /// environment's pretraining data); it forecasts workload with this
-    /// environment's model.
-    fn policy(&self, py: Python<'_>, policy_json: &str) -> PyResult<NativePolicy> {
+    /// environment's pretraining data); its own decisions (`Policy.act`)
+    /// forecast workload with this environment's model from its WL_0.
+    fn policy(&self, py: Python<'_>, policy_json: &str) -> PyResult<PyPolicyHandle> {
         let config: Box<dyn PolicyConfig> =
             parse_json("policy config", policy_json).map_err(to_py_err)?;
         let policy = py
             .detach(|| config.validate().and_then(|()| config.build(&self.task)))
             .map_err(to_py_err)?;
-        Ok(NativePolicy::new(
-            policy,
-            self.workload.clone(),
-            self.settings.wl0,
-        ))
+        PyPolicyHandle::new(policy, Some(self.workload.clone()), self.settings.wl0)
+            .map_err(to_py_err)
+    }
+
+    /// `policy`'s decision at the pending decision, with exactly the input
+    /// the session gives its policy (this environment's workload forecast
+    /// and query history): an arm, or `n_arms` to ask.
+    fn act(&self, py: Python<'_>, policy: &Bound<'_, PyPolicyHandle>) -> PyResult<usize> {
+        let policy = policy.get();
+        self.check_policy(policy)?;
+        let engine = self.engine()?;
+        let Some(p) = &engine.pending else {
+            return Err(to_py_err(HilError::state(
+                "gymnasium environment",
+                "no decision is pending: call reset()",
+            )));
+        };
+        let n_arms = self.n_arms();
+        py.detach(|| {
+            let forecast =
+                WorkloadForecast::new(Some(self.workload.as_ref()), p.wl0, &p.history, p.t);
+            let input = DecisionInput::new(&p.context, p.t, forecast).at_item(
+                p.item_index,
+                p.items_seen,
+                p.attempt,
+            );
+            Ok(match policy.state().decide(&input)?.choice {
+                Choice::Act { arm } => arm.0,
+                Choice::Query { .. } => n_arms,
+            })
+        })
+        .map_err(to_py_err)
+    }
+
+    /// Teaches `policy` every attempt the last step executed, as the
+    /// session loop tells its policy.
+    fn learn(&self, py: Python<'_>, policy: &Bound<'_, PyPolicyHandle>) -> PyResult<()> {
+        let policy = policy.get();
+        self.check_policy(policy)?;
+        let engine = self.engine()?;
+        let executed: &[StepEvent] = &engine.executed;
+        py.detach(|| {
+            let mut state = policy.state();
+            for (e, expert) in executed.iter().zip(from_expert(executed)) {
+                state.observe(
+                    &Feedback::new(&e.step.context, e.step.arm, e.outcome.reward(), e.step.t)
+                        .from_expert(expert),
+                )?;
+            }
+            Ok(())
+        })
+        .map_err(to_py_err)
     }
 }
 
 impl GymCore {
+    /// Refuses a policy for other arms or contexts than this environment's.
+    fn check_policy(&self, policy: &PyPolicyHandle) -> PyResult<()> {
+        let (n_arms, dim) = (self.n_arms(), self.dim());
+        if policy.n_arms() != n_arms || policy.dim() != dim {
+            return Err(to_py_err(HilError::invalid_input(
+                "policy",
+                format!(
+                    "it is for {} arms and d = {}, the environment has {n_arms} arms and d = {dim}",
+                    policy.n_arms(),
+                    policy.dim()
+                ),
+            )));
+        }
+        Ok(())
+    }
+
     fn build(config: GymConfig, base_dir: &str) -> hil_core::Result<Self> {
         config.session.validate()?;
         check_session_limits(&config.session)?;
@@ -572,243 +633,6 @@ fn pending_info(info: &Bound<'_, PyDict>, p: &Pending) -> PyResult<()> {
     Ok(())
 }
 
-/// A hil policy (any built-in or plugin type) driven from Python: through
-/// a [`GymCore`]'s decisions (`act` / `learn`), or on its own (`decide` /
-/// `observe`, keeping its own query history for the workload forecast).
-#[pyclass(module = "hil._hil", frozen)]
-pub(crate) struct NativePolicy {
-    inner: Mutex<PolicyState>,
-}
-
-struct PolicyState {
-    policy: Box<dyn Policy>,
-    forecast: Arc<dyn WorkloadModel>,
-    wl0: f64,
-    /// Queries asked through `decide`, for its forecasts.
-    history: QueryHistory,
-    /// Time spent inside the policy's own `decide` and `observe` by the
-    /// standalone methods, so that a benchmark can tell the policy's cost
-    /// from the cost of crossing from Python.
-    inner: Duration,
-}
-
-impl NativePolicy {
-    fn new(policy: Box<dyn Policy>, forecast: Arc<dyn WorkloadModel>, wl0: f64) -> Self {
-        Self {
-            inner: Mutex::new(PolicyState {
-                policy,
-                forecast,
-                wl0,
-                history: QueryHistory::new(),
-                inner: Duration::ZERO,
-            }),
-        }
-    }
-
-    fn state(&self) -> PyResult<MutexGuard<'_, PolicyState>> {
-        self.inner
-            .lock()
-            .map_err(|_| to_py_err(HilError::state("native policy", "a call panicked")))
-    }
-}
-
-impl PolicyState {
-    fn choose(
-        &mut self,
-        input: &DecisionInput<'_>,
-    ) -> hil_core::Result<(usize, Option<QueryKind>)> {
-        Ok(match self.policy.decide(input)?.choice {
-            Choice::Act { arm } => (arm.0, None),
-            Choice::Query { kind, .. } => (self.policy.n_arms(), Some(kind)),
-        })
-    }
-}
-
-#[pymethods]
-impl NativePolicy {
-    /// A policy from its config table as JSON, for `n_arms` arms and
-    /// contexts of dimension `dim`, forecasting workload with the bundled
-    /// model `workload` from `wl0`. `pretrain_contexts` (n × dim),
-    /// `pretrain_arms` and `pretrain_rewards` (length n) are the offline
-    /// data a config with `pretrain = true` fits first.
-    #[new]
-    #[pyo3(signature = (policy_json, n_arms, dim, workload_json, wl0 = 0.5, pretrain_contexts = None, pretrain_arms = None, pretrain_rewards = None))]
-    #[allow(clippy::too_many_arguments)]
-    fn py_new(
-        py: Python<'_>,
-        policy_json: &str,
-        n_arms: usize,
-        dim: usize,
-        workload_json: &str,
-        wl0: f64,
-        pretrain_contexts: Option<PyReadonlyArray2<'_, f64>>,
-        pretrain_arms: Option<Vec<usize>>,
-        pretrain_rewards: Option<Vec<f64>>,
-    ) -> PyResult<Self> {
-        let config: Box<dyn PolicyConfig> =
-            parse_json("policy config", policy_json).map_err(to_py_err)?;
-        let workload: Box<dyn WorkloadModelConfig> =
-            parse_json("workload config", workload_json).map_err(to_py_err)?;
-        hil_core::workload::check_wl0(wl0).map_err(to_py_err)?;
-        let actions =
-            ActionSpace::new((0..n_arms).map(|a| format!("arm{a}"))).map_err(to_py_err)?;
-        let ctx = BuildContext::new(".", 0);
-        let mut task = TaskContext::new(ctx.clone(), actions, dim);
-        match (pretrain_contexts, pretrain_arms, pretrain_rewards) {
-            (None, None, None) => {}
-            (Some(x), Some(arms), Some(rewards)) => {
-                let x = x.as_array();
-                if x.nrows() != arms.len() || x.nrows() != rewards.len() || x.ncols() != dim {
-                    return Err(PyValueError::new_err(format!(
-                        "pretraining data: contexts are {} x {}, arms {} and rewards {} long; expected n x {dim} and n, n",
-                        x.nrows(),
-                        x.ncols(),
-                        arms.len(),
-                        rewards.len()
-                    )));
-                }
-                let mut data = Vec::with_capacity(arms.len());
-                for (i, (&arm, &reward)) in arms.iter().zip(&rewards).enumerate() {
-                    let context = Context::new(x.row(i).to_vec()).map_err(|e| {
-                        to_py_err(HilError::invalid_input(
-                            format!("pretraining context {i}"),
-                            e.to_string(),
-                        ))
-                    })?;
-                    data.push(LabelledObservation {
-                        context,
-                        arm: ArmId(arm),
-                        reward,
-                    });
-                }
-                task = task.with_pretraining(data.into());
-            }
-            _ => {
-                return Err(PyValueError::new_err(
-                    "pretraining data needs all of pretrain_contexts, pretrain_arms and pretrain_rewards",
-                ));
-            }
-        }
-        let (policy, forecast) = py
-            .detach(|| -> hil_core::Result<_> {
-                config.validate()?;
-                workload.validate()?;
-                Ok((config.build(&task)?, workload.build(&ctx)?))
-            })
-            .map_err(to_py_err)?;
-        Ok(Self::new(policy, forecast, wl0))
-    }
-
-    /// The policy's name.
-    #[getter]
-    fn name(&self) -> PyResult<String> {
-        Ok(self.state()?.policy.name().to_string())
-    }
-
-    /// Decides at `env`'s pending decision: an arm, or `n_arms` to ask.
-    fn act(&self, py: Python<'_>, env: &GymCore) -> PyResult<usize> {
-        let engine = env.engine()?;
-        let Some(p) = &engine.pending else {
-            return Err(to_py_err(HilError::state(
-                "gymnasium environment",
-                "no decision is pending: call reset()",
-            )));
-        };
-        let mut guard = self.state()?;
-        let state: &mut PolicyState = &mut guard;
-        py.detach(|| {
-            let forecast = state.forecast.clone();
-            let input = DecisionInput::new(
-                &p.context,
-                p.t,
-                WorkloadForecast::new(Some(forecast.as_ref()), p.wl0, &p.history, p.t),
-            )
-            .at_item(p.item_index, p.items_seen, p.attempt);
-            state.choose(&input).map(|(a, _)| a)
-        })
-        .map_err(to_py_err)
-    }
-
-    /// Learns from every attempt `env`'s last step executed, as the
-    /// session loop would have told the policy.
-    fn learn(&self, py: Python<'_>, env: &GymCore) -> PyResult<()> {
-        let engine = env.engine()?;
-        let executed: &[StepEvent] = &engine.executed;
-        let mut guard = self.state()?;
-        let state: &mut PolicyState = &mut guard;
-        py.detach(|| {
-            for (e, expert) in executed.iter().zip(from_expert(executed)) {
-                state.policy.observe(
-                    &Feedback::new(&e.step.context, e.step.arm, e.outcome.reward(), e.step.t)
-                        .from_expert(expert),
-                )?;
-            }
-            Ok(())
-        })
-        .map_err(to_py_err)
-    }
-
-    /// Decides for context `x` at timestep `t` on its own: an arm, or
-    /// `n_arms` to ask (the query is added to its own history).
-    fn decide(&self, py: Python<'_>, x: PyReadonlyArray1<'_, f64>, t: Timestep) -> PyResult<usize> {
-        let context = crate::convert::context(x)?;
-        let mut guard = self.state()?;
-        let state: &mut PolicyState = &mut guard;
-        py.detach(|| {
-            let forecast = state.forecast.clone();
-            let history = std::mem::take(&mut state.history);
-            let input = DecisionInput::new(
-                &context,
-                t,
-                WorkloadForecast::new(Some(forecast.as_ref()), state.wl0, &history, t),
-            );
-            let start = Instant::now();
-            let chosen = state.choose(&input);
-            state.inner += start.elapsed();
-            state.history = history;
-            let (arm, kind) = chosen?;
-            if let Some(kind) = kind {
-                state.history.push(t, kind)?;
-            }
-            Ok(arm)
-        })
-        .map_err(to_py_err)
-    }
-
-    /// Learns that arm `arm` in context `x` gave `reward` at timestep `t`.
-    #[pyo3(signature = (x, arm, reward, t, from_expert = false))]
-    fn observe(
-        &self,
-        py: Python<'_>,
-        x: PyReadonlyArray1<'_, f64>,
-        arm: usize,
-        reward: f64,
-        t: Timestep,
-        from_expert: bool,
-    ) -> PyResult<()> {
-        let context = crate::convert::context(x)?;
-        let mut guard = self.state()?;
-        let state: &mut PolicyState = &mut guard;
-        py.detach(|| {
-            let start = Instant::now();
-            let r = state
-                .policy
-                .observe(&Feedback::new(&context, ArmId(arm), reward, t).from_expert(from_expert));
-            state.inner += start.elapsed();
-            r
-        })
-        .map_err(to_py_err)
-    }
-
-    /// Seconds spent inside the policy's own `decide` and `observe` by
-    /// the standalone `decide` / `observe` calls so far (the rest of a
-    /// call's time is the crossing from Python).
-    #[getter]
-    fn inner_seconds(&self) -> PyResult<f64> {
-        Ok(self.state()?.inner.as_secs_f64())
-    }
-}
-
 /// The paper's food split (`hil_envs::FoodSplit::paper`) as JSON: keys
 /// `pretrain`, `validation`, `test`, each a list of food names.
 #[pyfunction]
@@ -817,84 +641,8 @@ fn paper_food_split_json() -> PyResult<String> {
         .map_err(|e| to_py_err(HilError::serde("the paper's food split", e)))
 }
 
-// --- Study helpers for hil.envs' example (`examples/workload_study.py`):
-// the smallest native surface that loads a study, selects and fits a
-// workload model, in the same steps as `hil workload select` / `fit`.
-
-/// Cross-validates every candidate workload model on D1, D2 and D12 of the
-/// study CSV at `path` (`hil workload select`), returning the selection
-/// table as JSON (`rows`, each with `dataset`, `candidate`, the test MSEs
-/// and their `median`). `histories` are the Granger history lengths tried
-/// (None: hil's default grid, 1 to 30); `threads` = 0 uses every core.
-#[pyfunction]
-#[pyo3(signature = (path, histories = None, threads = 0, seed = 0))]
-fn study_select_json(
-    py: Python<'_>,
-    path: &str,
-    histories: Option<Vec<usize>>,
-    threads: usize,
-    seed: u64,
-) -> PyResult<String> {
-    use hil_workload::datasets::{Dataset, DatasetId};
-    use hil_workload::select::{Candidate, SelectOptions, cross_validate};
-    py.detach(|| -> hil_core::Result<String> {
-        let study = hil_workload::study::Study::load(Path::new(path))?;
-        let sets: Vec<Dataset> = DatasetId::ALL
-            .iter()
-            .map(|&id| Dataset::build(&study, id))
-            .collect::<hil_core::Result<_>>()?;
-        let refs: Vec<&Dataset> = sets.iter().collect();
-        let defaults = SelectOptions::default();
-        let opts = SelectOptions {
-            histories: histories.unwrap_or(defaults.histories.clone()),
-            seed,
-            threads,
-            ..defaults
-        };
-        let table = cross_validate(&refs, &Candidate::table(&opts.histories), &opts)?;
-        Ok(table.to_json())
-    })
-    .map_err(to_py_err)
-}
-
-/// Fits `candidate_json` (a `candidate` of [`study_select_json`]'s rows,
-/// e.g. `{"family": "exp_impulse"}`) on the `population` dataset (`d1`,
-/// `d2`, `d12`) of the study CSV at `path` (as `hil workload fit` does),
-/// returning the model file's JSON, which a `{"type": "model_file",
-/// "path": ...}` workload table loads.
-#[pyfunction]
-#[pyo3(signature = (path, population, candidate_json, seed = 0))]
-fn study_fit_json(
-    py: Python<'_>,
-    path: &str,
-    population: &str,
-    candidate_json: &str,
-    seed: u64,
-) -> PyResult<String> {
-    use hil_workload::datasets::DatasetId;
-    use hil_workload::models::FittedModel;
-    use hil_workload::select::{Candidate, SelectOptions, fit_study_model};
-    let cand: Candidate = parse_json("workload candidate", candidate_json).map_err(to_py_err)?;
-    let fitted = py
-        .detach(|| -> hil_core::Result<FittedModel> {
-            let study = hil_workload::study::Study::load(Path::new(path))?;
-            let id = DatasetId::parse(population)?;
-            let opts = SelectOptions {
-                seed,
-                ..SelectOptions::default()
-            };
-            fit_study_model(&study, id, cand, &opts, None)
-        })
-        .map_err(to_py_err)?;
-    serde_json::to_string_pretty(&fitted)
-        .map_err(|e| to_py_err(HilError::serde("fitted workload model", e)))
-}
-
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<GymCore>()?;
-    m.add_class::<NativePolicy>()?;
     m.add_function(wrap_pyfunction!(paper_food_split_json, m)?)?;
-    m.add_function(wrap_pyfunction!(study_select_json, m)?)?;
-    m.add_function(wrap_pyfunction!(study_fit_json, m)?)?;
     Ok(())
 }

@@ -12,7 +12,7 @@
 //! - [`registry`]: Python factories as named component types;
 //! - [`session`]: the session loop with its record and resume;
 //! - [`reproduce`]: the paper's simulated protocol;
-//! - [`interruptible`]: long runs that Ctrl-C stops and that report progress;
+//! - [`interrupt`]: long work that Ctrl-C stops and that reports progress;
 //! - [`workload`]: the study loader, fitting and model selection;
 //! - [`testing`]: the conformance suites.
 
@@ -22,7 +22,7 @@ mod components;
 mod convert;
 mod errors;
 mod gym;
-mod interruptible;
+mod interrupt;
 mod pycomponents;
 mod registry;
 mod reproduce;

@@ -315,7 +315,7 @@ pub(crate) fn reproduce(
         workload_models,
     }
     .add_to(&mut s)?;
-    let ran = crate::interruptible::run(py, progress, "hil.reproduce", |control| {
+    let ran = crate::interrupt::run(py, progress, "hil.reproduce", |control| {
         let protocol = Protocol::from_settings(s)?;
         let setup_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();

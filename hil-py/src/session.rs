@@ -1,7 +1,9 @@
 //! The session loop from Python, with its interaction record and resume,
 //! as `hil run` drives it: from an experiment file (`hil.run`,
 //! `hil.resume`) or from components given in code (`hil.run_session`,
-//! any of them Python objects). The GIL is released while it runs.
+//! any of them Python objects). The GIL is released while it runs, and
+//! Ctrl-C stops it between two steps ([`crate::interrupt`]), the log then
+//! holding every step so far.
 
 use std::path::{Path, PathBuf};
 
@@ -15,6 +17,7 @@ use pyo3::prelude::*;
 use crate::components::{channel_arg, environment_arg, policy_arg, workload_arg};
 use crate::convert::to_py;
 use crate::errors::IntoPy;
+use crate::interrupt::StopAtBoundary;
 
 /// The config text a component session's log header holds: its
 /// components were given in code, so a resume gives them again.
@@ -43,33 +46,36 @@ impl Recording {
     }
 }
 
-/// Runs `exp` as `recording` says, with the GIL released.
+/// Runs `exp` as `recording` says on a worker thread, with the GIL
+/// released; Ctrl-C (or any exception a signal handler raises) stops it at
+/// the next boundary between steps and is raised here, the interaction log
+/// holding every step so far (see [`crate::interrupt`]).
 fn drive(
     py: Python<'_>,
-    exp: &mut Experiment,
+    mut exp: Experiment,
     recording: Recording,
     events: bool,
 ) -> PyResult<Py<PyAny>> {
-    let mut collector = EventCollector::default();
-    let summary: ExperimentSummary = py
-        .detach(|| {
-            let mut observers: Vec<&mut dyn SessionObserver> = Vec::new();
-            if events {
-                observers.push(&mut collector);
-            }
-            match recording {
-                Recording::Resume(path) => {
-                    let (log, logged) = RecordLog::open(&path)?;
-                    run_recorded(exp, log, Some(&logged), &mut observers, |_, _| {})
-                }
-                Recording::To(path, header) => {
-                    let log = RecordLog::create(&path, header)?;
-                    run_recorded(exp, log, None, &mut observers, |_, _| {})
-                }
-                Recording::Off => exp.run(&mut observers, |_, _| {}),
-            }
-        })
-        .py_err()?;
+    let (summary, collector) = crate::interrupt::run(py, None, "session", move |control| {
+        let mut collector = EventCollector::default();
+        let mut stopper = StopAtBoundary(control);
+        let mut observers: Vec<&mut dyn SessionObserver> = Vec::new();
+        if events {
+            observers.push(&mut collector);
+        }
+        observers.push(&mut stopper);
+        let summary = match recording {
+            Recording::Resume(path) => RecordLog::open(&path).and_then(|(log, logged)| {
+                run_recorded(&mut exp, log, Some(&logged), &mut observers, |_, _| {})
+            }),
+            Recording::To(path, header) => RecordLog::create(&path, header)
+                .and_then(|log| run_recorded(&mut exp, log, None, &mut observers, |_, _| {})),
+            Recording::Off => exp.run(&mut observers, |_, _| {}),
+        };
+        drop(observers);
+        (summary, collector)
+    })?;
+    let summary: ExperimentSummary = summary.py_err()?;
     let out = to_py(py, &summary, "summary")?;
     if events {
         out.bind(py)
@@ -102,12 +108,12 @@ pub(crate) fn run(
     let base = config_abs
         .parent()
         .map_or_else(|| config_abs.clone(), Path::to_path_buf);
-    let mut exp = py.detach(|| cfg.build(&base)).py_err()?;
+    let exp = py.detach(|| cfg.build(&base)).py_err()?;
     let (seed, episodes) = (exp.seed, exp.episodes);
     let recording = Recording::of(log, None, || {
         Header::new(&text, config_abs, base, seed, episodes)
     });
-    drive(py, &mut exp, recording, events)
+    drive(py, exp, recording, events)
 }
 
 /// Continues the session recorded in `log` by `run(config, log=...)` (after
@@ -133,8 +139,8 @@ pub(crate) fn resume(py: Python<'_>, log: PathBuf, events: bool) -> PyResult<Py<
     let cfg = ExperimentConfig::parse(&header.config, &header.config_path)
         .map_err(HilError::from)
         .py_err()?;
-    let mut exp = py.detach(|| cfg.build(&header.base_dir)).py_err()?;
-    drive(py, &mut exp, Recording::Resume(log), events)
+    let exp = py.detach(|| cfg.build(&header.base_dir)).py_err()?;
+    drive(py, exp, Recording::Resume(log), events)
 }
 
 /// Runs `episodes` episodes of hil's session loop over components given in
@@ -170,7 +176,7 @@ pub(crate) fn run_session(
         .with_max_items(max_items);
     settings.validate().py_err()?;
     let (environment, _) = environment_arg(environment)?;
-    let mut exp = Experiment {
+    let exp = Experiment {
         settings,
         seed,
         episodes,
@@ -183,7 +189,7 @@ pub(crate) fn run_session(
     let recording = Recording::of(log, resume, || {
         Header::new(CODE_SESSION, "<python>", ".", seed, episodes)
     });
-    drive(py, &mut exp, recording, events)
+    drive(py, exp, recording, events)
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

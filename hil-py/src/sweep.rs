@@ -122,7 +122,7 @@ fn protocol_run_all_json(
     settings_json: &str,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<String> {
-    let outcome = crate::interruptible::run(py, progress, "hil.sweep", |control| {
+    let outcome = crate::interrupt::run(py, progress, "hil.sweep", |control| {
         let b = built(settings_json)?;
         b.protocol
             .run_until_cancelled(&|done, total| control.report(done, total), &control.cancel)

@@ -5,15 +5,17 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use hil_core::HilError;
 use hil_workload::bundle::{StudySummary, bundled_study};
 use hil_workload::datasets::{Dataset, DatasetId};
 use hil_workload::models::FittedModel;
 use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_study_model};
 use hil_workload::study::Study;
 use pyo3::prelude::*;
+use pyo3::types::PyString;
 
 use crate::components::PyWorkloadHandle;
-use crate::convert::to_py;
+use crate::convert::{from_py, to_py};
 use crate::errors::IntoPy;
 
 /// A querying-workload study (NASA-TLX surveys after robot queries), read
@@ -113,7 +115,8 @@ pub(crate) fn select_workload(
 }
 
 /// Fits `model` (`granger`, `granger_sim`, `exp_impulse`, `average`,
-/// `constant`, ... as `hil workload fit --model`) with history `history`
+/// `constant`, ... as `hil workload fit --model`, with history `history`;
+/// or a `candidate` dict of `select_workload`'s rows, which holds its own)
 /// on `population` (`d1`, `d2` or `d12`) of `study`, the ridge penalty
 /// chosen by CV where the model has one. Writes the model JSON to `out` if
 /// given. Returns the fitted `WorkloadModel`.
@@ -124,7 +127,7 @@ pub(crate) fn fit_workload(
     py: Python<'_>,
     study: &Bound<'_, PyStudy>,
     population: &str,
-    model: &str,
+    model: &Bound<'_, PyAny>,
     history: Option<usize>,
     name: Option<String>,
     cv_seed: u64,
@@ -133,7 +136,16 @@ pub(crate) fn fit_workload(
 ) -> PyResult<PyWorkloadHandle> {
     let study = study.get().inner.clone();
     let id = DatasetId::parse(population).py_err()?;
-    let cand = Candidate::parse(model, history).py_err()?;
+    let cand = match model.cast::<PyString>() {
+        Ok(name) => Candidate::parse(&name.to_cow()?, history).py_err()?,
+        Err(_) if history.is_some() => {
+            return Err(crate::errors::to_py_err(HilError::invalid_input(
+                "history",
+                "give it with a model name; a candidate dict holds its own",
+            )));
+        }
+        Err(_) => from_py::<Candidate>(model, "model")?,
+    };
     let opts = options(cv_seed, threads);
     let fitted = py
         .detach(|| -> hil_core::Result<FittedModel> {

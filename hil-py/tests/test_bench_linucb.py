@@ -36,11 +36,11 @@ def test_numpy_reference_picks_the_same_arms_as_hils_linucb():
     ref.fit(*w.pretrain)
     decide, observe, _ = bench.make_hil(w, {"type": "linucb", "alpha": bench.ALPHA,
                                             "pretrain": True})
-    for _ in range(30):
+    for t in range(1, 31):
         x = w.contexts(1)[0]
-        arm = decide(x)
+        arm = decide(x, t)
         assert arm == ref.decide(x)
         r = w.reward(x, arm)
-        observe(x, arm, r, False)
+        observe(x, arm, r, t, False)
         ref.observe(x, arm, r)
     assert np.isfinite(ref.a_inv).all()

@@ -108,10 +108,10 @@ def test_native_linucb_qg_drives_the_environment():
     obs, info = env.reset(seed=1)
     done, steps = False, 0
     while not done:
-        action = qg.act(env.core)
+        action = env.act(qg)
         assert 0 <= action <= env.n_arms
         obs, _, done, _, info = env.step(action)
-        qg.learn(env.core)
+        env.learn(qg)
         steps += 1
     assert info["episode"]["n_items"] == 3 and steps >= 3
 

@@ -145,7 +145,10 @@ class WorkloadModel:
     ) -> npt.NDArray[np.float64]: ...
 
 class Policy:
-    """A hil policy (any built-in or registered type), validated at construction."""
+    """A hil policy (any built-in or registered type), validated at construction.
+
+    `forecast` and `wl0` are what its own decisions (`act`, and `decide`
+    without `workload=`) forecast workload with."""
 
     def __init__(
         self,
@@ -157,6 +160,8 @@ class Policy:
         dim: Optional[int] = None,
         pretraining: Optional[Tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike]] = None,
         seed: int = 0,
+        forecast: Optional[_WorkloadLike] = None,
+        wl0: float = 0.5,
         **params: Any,
     ) -> None: ...
     @property
@@ -175,10 +180,20 @@ class Policy:
         items_seen: int = 0,
         attempt: int = 0,
         workload: Optional[WorkloadModel] = None,
-        wl0: float = 0.5,
+        wl0: Optional[float] = None,
         query_times: Optional[Sequence[int]] = None,
     ) -> Dict[str, Any]: ...
-    def observe(self, context: npt.ArrayLike, arm: int, reward: float, t: int = 1, *, from_expert: bool = False) -> None: ...
+    def act(
+        self, context: npt.ArrayLike, t: int = 1, *, item_index: int = 0, items_seen: int = 0, attempt: int = 0
+    ) -> int:
+        """The arm to execute, or `n_arms` to ask; an ask joins `query_times`."""
+    def observe(self, context: npt.ArrayLike, arm: int, reward: float, t: int = 1, from_expert: bool = False) -> None: ...
+    @property
+    def query_times(self) -> List[int]: ...
+    def clear_queries(self) -> None: ...
+    @property
+    def inner_seconds(self) -> float:
+        """Seconds spent inside the policy's own decide and observe so far."""
     def save(self) -> str: ...
     def restore(self, state: Union[str, _Json]) -> None: ...
     def diagnostics(
@@ -187,7 +202,7 @@ class Policy:
         t: int = 1,
         *,
         workload: Optional[WorkloadModel] = None,
-        wl0: float = 0.5,
+        wl0: Optional[float] = None,
         query_times: Optional[Sequence[int]] = None,
     ) -> Dict[str, Any]: ...
 
@@ -236,7 +251,7 @@ def fit_workload(
     study: Study,
     *,
     population: str,
-    model: str,
+    model: Union[str, Mapping[str, Any]],
     history: Optional[int] = None,
     name: Optional[str] = None,
     cv_seed: int = 0,
@@ -321,43 +336,11 @@ class GymCore:
     def step(
         self, action: int
     ) -> tuple[_npt.NDArray[_np.float64], float, float, float, bool, dict]: ...
-    def policy(self, policy_json: str) -> NativePolicy: ...
-
-class NativePolicy:
-    """A hil policy (built-in or plugin) driven from Python."""
-
-    def __init__(
-        self,
-        policy_json: str,
-        n_arms: int,
-        dim: int,
-        workload_json: str,
-        wl0: float = 0.5,
-        pretrain_contexts: _npt.NDArray[_np.float64] | None = None,
-        pretrain_arms: list[int] | None = None,
-        pretrain_rewards: list[float] | None = None,
-    ) -> None: ...
-    @property
-    def name(self) -> str: ...
-    @property
-    def inner_seconds(self) -> float: ...
-    def act(self, env: GymCore) -> int: ...
-    def learn(self, env: GymCore) -> None: ...
-    def decide(self, x: _npt.NDArray[_np.float64], t: int) -> int: ...
-    def observe(
-        self,
-        x: _npt.NDArray[_np.float64],
-        arm: int,
-        reward: float,
-        t: int,
-        from_expert: bool = False,
-    ) -> None: ...
+    def policy(self, policy_json: str) -> Policy: ...
+    def act(self, policy: Policy) -> int: ...
+    def learn(self, policy: Policy) -> None: ...
 
 def paper_food_split_json() -> str: ...
-def study_select_json(
-    path: str, histories: list[int] | None = None, threads: int = 0, seed: int = 0
-) -> str: ...
-def study_fit_json(path: str, population: str, candidate_json: str, seed: int = 0) -> str: ...
 def protocol_preset_json(name: str) -> str: ...
 def protocol_settings_from_file(path: str) -> str: ...
 def protocol_jobs_json(settings_json: str) -> str: ...

@@ -79,7 +79,6 @@ from . import _hil
 __all__ = [
     "HilEnv",
     "FoodReplayEnv",
-    "NativePolicy",
     "paper_food_split",
     "register_envs",
     "DEFAULT_WORKLOAD",
@@ -92,9 +91,6 @@ DEFAULT_WORKLOAD: dict = {"type": "bundled", "name": "f12_sim"}
 #: The default query channel: hil-channels' simulated expert (the paper's
 #: perfect expert; seeded by the episode seed).
 DEFAULT_CHANNEL: dict = {"type": "simulated_expert"}
-
-NativePolicy = _hil.NativePolicy
-
 
 def paper_food_split() -> dict:
     """The paper's food split: ``{"pretrain": [...], "validation": [...],
@@ -117,7 +113,7 @@ class HilEnv(gym.Env):
             ``"bounding_box/hard/easy"``); hil's default kind if None.
         fallback_arm: the arm executed when the channel gives no arm back.
         build_seed: seed of the components' construction (e.g. the
-            pretraining data offered to a ``NativePolicy``).
+            pretraining data offered to :meth:`policy`).
         base_dir: directory relative paths in the tables resolve against.
 
     Raises:
@@ -196,26 +192,38 @@ class HilEnv(gym.Env):
             info["episode"] = json.loads(episode)
         return obs, float(reward), bool(terminated), False, info
 
-    def policy(self, config: dict) -> NativePolicy:
-        """A hil policy for this environment (any built-in or plugin type),
-        built as an experiment builds it, with the environment's pretraining
-        data; it forecasts workload with this environment's model.
+    def policy(self, config: dict) -> _hil.Policy:
+        """A :class:`hil.Policy` for this environment (any built-in or plugin
+        type), built as an experiment builds it, with the environment's
+        pretraining data; its own decisions (``Policy.act``) forecast
+        workload with this environment's model.
 
-        Drive it with ``policy.act(env.core)`` before a step and
-        ``policy.learn(env.core)`` after it (``env.unwrapped`` under
+        Let it choose each step's action with :meth:`act` and teach it what
+        the step executed with :meth:`learn` (``env.unwrapped`` under
         wrappers)::
 
-            env = gymnasium.make("hil/FoodReplay-v0")
-            qg = env.unwrapped.policy({"type": "linucb_qg", "alpha": 0.5,
-                                       "w": 4.0, "pretrain": True})
+            env = gymnasium.make("hil/FoodReplay-v0").unwrapped
+            qg = env.policy({"type": "linucb_qg", "alpha": 0.5, "w": 4.0,
+                             "pretrain": True})
             obs, info = env.reset(seed=0)
             done = False
             while not done:
-                action = qg.act(env.unwrapped.core)
-                obs, reward, done, _, info = env.step(action)
-                qg.learn(env.unwrapped.core)
+                obs, reward, done, _, info = env.step(env.act(qg))
+                env.learn(qg)
         """
         return self.core.policy(json.dumps(config))
+
+    def act(self, policy: _hil.Policy) -> int:
+        """``policy``'s action at the pending decision (an arm, or
+        :attr:`ask_action`), given exactly the input hil's session gives a
+        policy: the observation, the item and attempt, and this
+        environment's workload forecast and query history."""
+        return self.core.act(policy)
+
+    def learn(self, policy: _hil.Policy) -> None:
+        """Teaches ``policy`` every attempt the last step executed (after a
+        query: the expert's arm, marked as such), as hil's session does."""
+        self.core.learn(policy)
 
 
 class FoodReplayEnv(HilEnv):

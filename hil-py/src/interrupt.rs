@@ -1,16 +1,25 @@
-//! Long runs that Ctrl-C stops and that report progress: the work runs on a
-//! scoped thread with the GIL released, while the calling thread wakes
+//! Long Rust work that Ctrl-C stops and that reports progress.
+//!
+//! CPython runs signal handlers only on the main thread and only when that
+//! thread executes Python code, so a call that stays in Rust for minutes
+//! would swallow Ctrl-C until it returns. [`run`] therefore runs the work
+//! on a scoped thread with the GIL released, while the calling thread wakes
 //! every [`POLL`] to report progress and to let Python run its signal
 //! handlers. A `KeyboardInterrupt` (or any exception the progress callback
 //! raises) raises the work's cancel flag, waits for the work to stop, and
-//! is then raised to the caller.
+//! is then raised to the caller, so nothing keeps running behind the
+//! exception.
 //!
-//! Self-contained on purpose: any long call (`hil.reproduce`, the
-//! in-process `hil.sweep`) wraps its work in [`run`].
+//! The work checks the flag where stopping leaves things consistent:
+//! `Protocol::run_until_cancelled` between runs (`hil.reproduce`, the
+//! in-process `hil.sweep`), and [`StopAtBoundary`] between the steps of
+//! hil's session loop (`hil.run`, `hil.run_session`), so an interaction log
+//! written so far is complete and `resume` continues it.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Duration;
 
+use hil_core::{HilError, Item, SessionObserver, StepEvent};
 use pyo3::prelude::*;
 
 /// How often the caller's thread wakes to check signals and report.
@@ -30,6 +39,11 @@ impl Control {
     pub(crate) fn report(&self, done: usize, total: usize) {
         self.total.store(total, Ordering::Relaxed);
         self.done.fetch_max(done, Ordering::Relaxed);
+    }
+
+    /// Whether the caller asked the work to stop.
+    pub(crate) fn cancelled(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed)
     }
 
     fn progress(&self) -> (usize, usize) {
@@ -129,4 +143,34 @@ pub(crate) fn run<T: Send>(
             ))),
         }
     })
+}
+
+/// A session observer that ends the session at the next boundary between
+/// steps once the caller asked to stop: after a step's outcome is recorded,
+/// or before an item or episode starts (never between a recorded step and
+/// its outcome). Put it after the recorder, which has then written the step.
+pub(crate) struct StopAtBoundary<'c>(pub(crate) &'c Control);
+
+impl StopAtBoundary<'_> {
+    /// An error ending the session when a stop was asked for (the caller
+    /// raises the Python exception that asked; this error only ends the work).
+    fn check(&self) -> hil_core::Result<()> {
+        if self.0.cancelled() {
+            Err(HilError::state("session", "interrupted from Python"))
+        } else {
+            Ok(())
+        }
+    }
+}
+
+impl SessionObserver for StopAtBoundary<'_> {
+    fn on_episode_start(&mut self, _: u64) -> hil_core::Result<()> {
+        self.check()
+    }
+    fn on_item_start(&mut self, _: &Item) -> hil_core::Result<()> {
+        self.check()
+    }
+    fn on_step(&mut self, _: &StepEvent) -> hil_core::Result<()> {
+        self.check()
+    }
 }

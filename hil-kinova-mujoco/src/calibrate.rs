@@ -79,9 +79,12 @@ pub struct SettingCell {
     pub setting: Setting,
     /// Trials run.
     pub trials: usize,
+    /// Trials discarded under the published rule (fewer than
+    /// [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines touched the item).
+    pub discarded: usize,
     /// Successes.
     pub successes: usize,
-    /// Achieved success rate.
+    /// Achieved success rate over the trials that counted.
     pub rate: f64,
     /// Binomial standard error of `rate`, √(p(1−p)/n).
     pub se: f64,
@@ -98,9 +101,12 @@ pub struct CalibrationRow {
     pub action: String,
     /// Trials run.
     pub trials: usize,
+    /// Trials discarded under the published rule (fewer than
+    /// [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines touched the item).
+    pub discarded: usize,
     /// Successes.
     pub successes: usize,
-    /// Achieved success rate.
+    /// Achieved success rate over the trials that counted.
     pub rate: f64,
     /// Binomial standard error of `rate`, √(p(1−p)/n).
     pub se: f64,
@@ -328,6 +334,19 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// Trials, discarded trials and successes among `records`: an attempt in
+/// which fewer than [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines
+/// touched the item is discarded, as in the published data set, and counts
+/// neither way.
+fn count(records: &[&&AttemptRecord]) -> (usize, usize, usize) {
+    let discarded = records.iter().filter(|r| !r.report.counted).count();
+    let successes = records
+        .iter()
+        .filter(|r| r.report.counted && r.report.success)
+        .count();
+    (records.len(), discarded, successes)
+}
+
 /// Groups attempt records into rows per (food, action), in job order.
 fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<CalibrationRow> {
     let mut rows = Vec::new();
@@ -341,23 +360,23 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                 .settings
                 .iter()
                 .map(|&setting| {
-                    let trials = cell.iter().filter(|r| r.setting == setting).count();
-                    let successes = cell
-                        .iter()
-                        .filter(|r| r.setting == setting && r.report.success)
-                        .count();
+                    let here: Vec<&&AttemptRecord> =
+                        cell.iter().filter(|r| r.setting == setting).collect();
+                    let (trials, discarded, successes) = count(&here);
+                    let counted = trials - discarded;
                     SettingCell {
                         setting,
                         trials,
+                        discarded,
                         successes,
-                        rate: successes as f64 / trials.max(1) as f64,
-                        se: binomial_se(successes, trials),
+                        rate: successes as f64 / counted.max(1) as f64,
+                        se: binomial_se(successes, counted),
                         published: Some(food.published_rates_in(setting)[a]),
                     }
                 })
                 .collect();
-            let trials = cell.len();
-            let successes = cell.iter().filter(|r| r.report.success).count();
+            let (trials, discarded, successes) = count(&cell.iter().collect::<Vec<_>>());
+            let counted = trials - discarded;
             // With all three settings equally represented the published
             // `all` row applies; otherwise the trial-weighted mean of the
             // settings run.
@@ -378,9 +397,10 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                 food: food.name().into(),
                 action: action.name.into(),
                 trials,
+                discarded,
                 successes,
-                rate: successes as f64 / trials.max(1) as f64,
-                se: binomial_se(successes, trials),
+                rate: successes as f64 / counted.max(1) as f64,
+                se: binomial_se(successes, counted),
                 published,
                 by_setting,
             });

@@ -450,6 +450,10 @@ pub struct FoodProps {
     pub friction: f64,
     /// Lateral load the flesh bears before a tine tears out (N per metre embedded).
     pub tear_per_m: f64,
+    /// Friction coefficient of the item on the plate and its rim (a wet
+    /// slice slides more easily than a dry stick): whether an angled push
+    /// slides the item away before the tines are in.
+    pub plate_friction: f64,
     /// Sideways slot a tine may cut before it tears out (m).
     pub cut_limit: f64,
     /// True colour (RGB).
@@ -482,6 +486,8 @@ pub struct FoodModel {
     pub friction: (f64, f64),
     /// Mean tear strength (N/m) and relative sd.
     pub tear_per_m: (f64, f64),
+    /// Friction coefficient on the plate (mean, relative sd).
+    pub plate_friction: (f64, f64),
     /// Sideways slot before a tine tears out, as a fraction of the item's
     /// minor half-extent.
     pub cut_fraction_of_width: f64,
@@ -509,6 +515,7 @@ impl FoodModel {
                 grip_per_m: (0.3, 0.5),
                 friction: (1.1, 0.3),
                 tear_per_m: (22.0, 0.3),
+                plate_friction: (0.6, 0.15),
                 cut_fraction_of_width: 0.3,
             },
             FoodKind::Carrot => FoodModel {
@@ -522,6 +529,7 @@ impl FoodModel {
                 grip_per_m: (60.0, 0.3),
                 friction: (0.8, 0.2),
                 tear_per_m: (1500.0, 0.3),
+                plate_friction: (0.6, 0.15),
                 cut_fraction_of_width: 0.5,
             },
             FoodKind::Cantaloupe => FoodModel {
@@ -535,6 +543,7 @@ impl FoodModel {
                 grip_per_m: (1.5, 0.5),
                 friction: (0.8, 0.3),
                 tear_per_m: (200.0, 0.3),
+                plate_friction: (0.6, 0.15),
                 cut_fraction_of_width: 0.4,
             },
             FoodKind::Honeydew | FoodKind::Kiwi | FoodKind::Celery => {
@@ -586,6 +595,7 @@ impl FoodModel {
             grip_per_m: pos(self.grip_per_m.0, self.grip_per_m.1),
             friction: pos(self.friction.0, self.friction.1),
             tear_per_m: pos(self.tear_per_m.0, self.tear_per_m.1),
+            plate_friction: pos(self.plate_friction.0, self.plate_friction.1),
             cut_limit: self.cut_fraction_of_width * shape.half_extents()[1],
             colour: self.kind.colour(),
         }

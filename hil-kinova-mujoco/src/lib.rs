@@ -73,8 +73,7 @@ pub use model::MjcfSource;
 pub use render::{Keyframe, KeyframeRecorder, KeyframeWriter, RenderingEnv, View};
 #[cfg(feature = "physics")]
 pub use sim::{
-    AttemptReport, FREE_DT, PUBLISHED_HOLD, PerceivedTarget, Placement, Simulator, StopReason,
-};
+    AttemptReport, FREE_DT, PUBLISHED_HOLD, PerceivedTarget, Placement, Simulator, StopReason, MIN_TINES_TOUCHED};
 #[cfg(feature = "physics")]
 pub use skewer::{MAX_DT, REF_DT};
 

@@ -408,3 +408,65 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
     }
     rows
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::StopReason;
+    use crate::skewer::SkewerStats;
+
+    fn record(setting: Setting, touched: usize, success: bool) -> AttemptRecord {
+        AttemptRecord {
+            food: FoodKind::Banana,
+            setting,
+            trial: 0,
+            seed: 0,
+            report: AttemptReport {
+                action: ACTIONS[0].name,
+                food: FoodKind::Banana,
+                success,
+                reached_pitch: 0.0,
+                reached_gamma: 0.0,
+                reached_roll: 0.0,
+                handle_roll: 0.0,
+                stop: StopReason::Force,
+                peak_force: 0.0,
+                tines: SkewerStats {
+                    touched,
+                    ..SkewerStats::default()
+                },
+                push_shift: 0.0,
+                push_tilt: 0.0,
+                counted: touched >= crate::sim::MIN_TINES_TOUCHED,
+                final_height: 0.0,
+                lifted_height: 0.0,
+                hold_slip: 0.0,
+                sim_time: 0.0,
+                steps: 0,
+            },
+        }
+    }
+
+    #[test]
+    fn attempts_with_fewer_than_two_tines_touching_are_discarded_not_failed() {
+        let opts = CalibrationOptions {
+            foods: vec![FoodKind::Banana],
+            settings: vec![Setting::Isolated],
+            trials: 4,
+            ..CalibrationOptions::default()
+        };
+        let records = [
+            record(Setting::Isolated, 4, true),
+            record(Setting::Isolated, 3, false),
+            record(Setting::Isolated, 1, false),
+            record(Setting::Isolated, 0, false),
+        ];
+        let rows = tabulate(&opts, &records);
+        let vs0 = &rows[0];
+        assert_eq!((vs0.trials, vs0.discarded, vs0.successes), (4, 2, 1));
+        assert_eq!(vs0.rate, 0.5);
+        assert_eq!(vs0.se, binomial_se(1, 2));
+        assert_eq!(vs0.by_setting[0].discarded, 2);
+        assert_eq!(vs0.by_setting[0].rate, 0.5);
+    }
+}

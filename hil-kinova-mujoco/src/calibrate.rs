@@ -144,6 +144,14 @@ pub struct CalibrationReport {
     pub max_abs_error: f64,
     /// Mean absolute difference per setting cell.
     pub mean_abs_error_by_setting: f64,
+    /// The mean absolute difference a *perfect* simulator would be expected
+    /// to show over the same overall rows: one whose true rate in every
+    /// setting is the published one, so that only the sampling noise of
+    /// both tables remains (the published cells rest on
+    /// [`PUBLISHED_TRIALS_PER_SETTING`] trials per setting; the simulated
+    /// ones on the trials counted here). The floor `mean_abs_error` is to
+    /// be read against.
+    pub noise_floor: f64,
     /// How long an item had to stay on the lifted fork (s).
     pub hold_s: f64,
     /// What turned the tine row by the actions' roll.
@@ -292,7 +300,14 @@ pub fn calibrate_with(
         .iter()
         .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
         .fold(0.0, f64::max);
+    let noise_floor = mean(
+        rows.iter()
+            .filter(|r| r.published.is_some())
+            .map(expected_abs_error_of_a_perfect_simulator)
+            .collect(),
+    );
     Ok(CalibrationReport {
+        noise_floor,
         max_abs_error,
         hold_s,
         roll_by: opts.roll_by,
@@ -319,6 +334,61 @@ pub fn calibrate_with(
         rows,
         note: "simulated (MuJoCo) attempts with synthetic food properties; published rates: Feng et al. 2019 (settings isolated, wall, lettuce; `all` is their mean)",
     })
+}
+
+/// Trials per (food, action, setting) behind the published rates (Feng et
+/// al. 2019: 10 per setting, 30 per overall cell).
+pub const PUBLISHED_TRIALS_PER_SETTING: usize = 10;
+
+/// The expected |simulated − published| of `row` for a simulator whose
+/// true rate in every setting equals the published one: the overall
+/// published rate is the sum of [`PUBLISHED_TRIALS_PER_SETTING`]-trial
+/// binomials over the row's settings, the simulated one the sum of
+/// binomials over the trials counted per setting; both distributions are
+/// enumerated exactly.
+pub fn expected_abs_error_of_a_perfect_simulator(row: &CalibrationRow) -> f64 {
+    let sum_of = |trials: &dyn Fn(&SettingCell) -> usize| -> Vec<f64> {
+        row.by_setting.iter().fold(vec![1.0], |dist, c| {
+            convolve(&dist, &binomial_pmf(trials(c), c.published.unwrap_or(0.0)))
+        })
+    };
+    let published = sum_of(&|_| PUBLISHED_TRIALS_PER_SETTING);
+    let simulated = sum_of(&|c| c.trials - c.discarded);
+    let (np, ns) = (published.len() - 1, simulated.len() - 1);
+    if np == 0 || ns == 0 {
+        return 0.0;
+    }
+    let mut e = 0.0;
+    for (i, pi) in published.iter().enumerate() {
+        for (j, pj) in simulated.iter().enumerate() {
+            e += pi * pj * (i as f64 / np as f64 - j as f64 / ns as f64).abs();
+        }
+    }
+    e
+}
+
+/// Probabilities of 0..=n successes in n trials at rate p.
+fn binomial_pmf(n: usize, p: f64) -> Vec<f64> {
+    let mut out = Vec::with_capacity(n + 1);
+    let mut c = 1.0; // n choose k, built up as k grows
+    for k in 0..=n {
+        if k > 0 {
+            c *= (n - k + 1) as f64 / k as f64;
+        }
+        out.push(c * p.powi(k as i32) * (1.0 - p).powi((n - k) as i32));
+    }
+    out
+}
+
+/// The distribution of the sum of two independent counts.
+fn convolve(a: &[f64], b: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; a.len() + b.len() - 1];
+    for (i, x) in a.iter().enumerate() {
+        for (j, y) in b.iter().enumerate() {
+            out[i + j] += x * y;
+        }
+    }
+    out
 }
 
 /// Binomial standard error of a rate of `successes` in `trials`.
@@ -445,6 +515,46 @@ mod tests {
                 steps: 0,
             },
         }
+    }
+
+    #[test]
+    fn a_perfect_simulator_still_differs_by_the_sampling_noise() {
+        let cell = |published: f64, trials: usize| SettingCell {
+            setting: Setting::Isolated,
+            trials,
+            discarded: 0,
+            successes: 0,
+            rate: 0.0,
+            se: 0.0,
+            published: Some(published),
+        };
+        let row = |published: f64, trials: usize| CalibrationRow {
+            food: "banana".into(),
+            action: "VS0".into(),
+            trials,
+            discarded: 0,
+            successes: 0,
+            rate: 0.0,
+            se: 0.0,
+            published: Some(published),
+            by_setting: vec![cell(published, trials)],
+        };
+        // Certain outcomes leave no noise.
+        assert_eq!(expected_abs_error_of_a_perfect_simulator(&row(1.0, 20)), 0.0);
+        assert_eq!(expected_abs_error_of_a_perfect_simulator(&row(0.0, 20)), 0.0);
+        // p = 0.5, 10 published and 10 simulated trials: E|X - Y|/10 with
+        // X - Y ~ 20-trial binomial shifted by 10, by enumeration.
+        let exact: f64 = (0..=20usize)
+            .map(|k| {
+                let c = (1..=k).fold(1.0, |c, i| c * (20 - i + 1) as f64 / i as f64);
+                c * 0.5f64.powi(20) * (k as f64 - 10.0).abs() / 10.0
+            })
+            .sum();
+        let e = expected_abs_error_of_a_perfect_simulator(&row(0.5, 10));
+        assert!((e - exact).abs() < 1e-12, "{e} vs {exact}");
+        // More simulated trials shrink it, but not below the published noise.
+        let more = expected_abs_error_of_a_perfect_simulator(&row(0.5, 1000));
+        assert!(more < e && more > 0.1, "{more}");
     }
 
     #[test]

@@ -497,10 +497,32 @@ impl FoodModel {
     /// The built-in (calibrated) model of `kind`.
     pub fn default_for(kind: FoodKind) -> Self {
         if kind.is_derived() {
-            // The base kind's distributions, unchanged (see FoodKind).
-            return FoodModel {
-                kind,
-                ..Self::default_for(kind.base())
+            // The base kind's shape and distributions, with the mechanical
+            // properties that set this food apart calibrated to its own
+            // published rates (see FoodKind).
+            let base = Self::default_for(kind.base());
+            return match kind {
+                // Melon like cantaloupe: the same flesh.
+                FoodKind::Honeydew => FoodModel { kind, ..base },
+                // A kiwi slice is firmer than banana and its seeds and
+                // core grip a tine: more puncture force, grip and tear
+                // strength.
+                FoodKind::Kiwi => FoodModel {
+                    kind,
+                    puncture_force: (0.8, 0.3),
+                    grip_per_m: (3.0, 0.5),
+                    friction: (1.3, 0.3),
+                    tear_per_m: (40.0, 0.3),
+                    ..base
+                },
+                // Celery's fibres part far more easily than a carrot's
+                // flesh: four tines pierce it within VS's and TV's limits.
+                FoodKind::Celery => FoodModel {
+                    kind,
+                    puncture_force: (3.5, 0.15),
+                    ..base
+                },
+                _ => base,
             };
         }
         match kind {

@@ -53,8 +53,9 @@ mod without_physics;
 
 #[cfg(feature = "physics")]
 pub use calibrate::{
-    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow, SettingCell, calibrate,
-    calibrate_with,
+    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow,
+    PUBLISHED_TRIALS_PER_SETTING, SettingCell, calibrate, calibrate_with,
+    expected_abs_error_of_a_perfect_simulator,
 };
 #[cfg(feature = "physics")]
 pub use controller::{ACTIONS, Action, RollBy};

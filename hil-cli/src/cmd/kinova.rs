@@ -271,6 +271,11 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         report.micros_per_step,
         100.0 * report.overhead_share
     );
+    println!(
+        "a perfect simulator (true rates = the published ones) would still average {:.3}: the sampling noise of {} published trials per setting and of these",
+        report.noise_floor,
+        hil_kinova_mujoco::PUBLISHED_TRIALS_PER_SETTING
+    );
     let discarded: usize = report.rows.iter().map(|r| r.discarded).sum();
     println!(
         "{discarded} of {} attempts discarded (fewer than {} tines touched the item, as in the published data set); rates are over the rest",

@@ -510,9 +510,8 @@ impl FoodModel {
                 FoodKind::Kiwi => FoodModel {
                     kind,
                     puncture_force: (0.8, 0.3),
-                    grip_per_m: (3.0, 0.5),
-                    friction: (1.3, 0.3),
-                    tear_per_m: (40.0, 0.3),
+                    grip_per_m: (1.0, 0.5),
+                    tear_per_m: (30.0, 0.3),
                     ..base
                 },
                 // Celery's fibres part far more easily than a carrot's

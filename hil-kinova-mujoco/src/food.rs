@@ -536,7 +536,7 @@ impl FoodModel {
                 grip_per_m: (0.3, 0.5),
                 friction: (1.1, 0.3),
                 tear_per_m: (22.0, 0.3),
-                plate_friction: (0.6, 0.15),
+                plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.3,
             },
             FoodKind::Carrot => FoodModel {
@@ -550,7 +550,7 @@ impl FoodModel {
                 grip_per_m: (60.0, 0.3),
                 friction: (0.8, 0.2),
                 tear_per_m: (1500.0, 0.3),
-                plate_friction: (0.6, 0.15),
+                plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.5,
             },
             FoodKind::Cantaloupe => FoodModel {
@@ -564,7 +564,7 @@ impl FoodModel {
                 grip_per_m: (1.5, 0.5),
                 friction: (0.8, 0.3),
                 tear_per_m: (200.0, 0.3),
-                plate_friction: (0.6, 0.15),
+                plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.4,
             },
             FoodKind::Honeydew | FoodKind::Kiwi | FoodKind::Celery => {

@@ -22,11 +22,11 @@ use hil_envs::feeding::{FeedingTask, FoodFacts};
 /// that are not on the plate, as the paper did. A derived kind is one of
 /// the 16 published foods and takes from the feeding data its name,
 /// description, published rates and expert answer, and its own colour; its
-/// shape and mechanics are those of its base kind ([`FoodKind::base`]),
-/// unchanged, and it is staged in its base kind's body. Its simulated
-/// success rates are therefore its base kind's, **not calibrated** to the
-/// published rates of the food it is named after (`hil kinova calibrate
-/// --foods honeydew,kiwi,celery` shows both).
+/// shape is that of its base kind ([`FoodKind::base`]) and it is staged in
+/// its base kind's body; its mechanics are the base kind's with the
+/// properties that set it apart calibrated to its own published rates
+/// ([`FoodModel::default_for`]; `hil kinova calibrate --foods
+/// honeydew,kiwi,celery` shows both).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
 #[serde(rename_all = "snake_case")]
 pub enum FoodKind {
@@ -36,11 +36,11 @@ pub enum FoodKind {
     Carrot,
     /// A cantaloupe cube: medium, juicy.
     Cantaloupe,
-    /// A honeydew cube, derived from cantaloupe (not calibrated).
+    /// A honeydew cube, derived from cantaloupe (its flesh).
     Honeydew,
-    /// A kiwi slice, derived from banana (not calibrated).
+    /// A kiwi slice, derived from banana (firmer, grips better).
     Kiwi,
-    /// A celery piece, derived from carrot (not calibrated).
+    /// A celery piece, derived from carrot (pierced more easily).
     Celery,
 }
 
@@ -69,7 +69,7 @@ impl FoodKind {
         }
     }
 
-    /// Whether this kind is derived from another (not calibrated).
+    /// Whether this kind is derived from another (shares its shape and body).
     pub fn is_derived(self) -> bool {
         self.base() != self
     }

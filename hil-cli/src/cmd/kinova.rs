@@ -635,7 +635,11 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
                 (f, mean_sem(&xs))
             })
             .collect();
-        let depth = mine.iter().map(|m| m.n_q_by_attempt.len()).max().unwrap_or(0);
+        let depth = mine
+            .iter()
+            .map(|m| m.n_q_by_attempt.len())
+            .max()
+            .unwrap_or(0);
         let by_attempt = (0..depth)
             .map(|i| {
                 let xs: Vec<f64> = mine

@@ -540,8 +540,14 @@ mod tests {
             by_setting: vec![cell(published, trials)],
         };
         // Certain outcomes leave no noise.
-        assert_eq!(expected_abs_error_of_a_perfect_simulator(&row(1.0, 20)), 0.0);
-        assert_eq!(expected_abs_error_of_a_perfect_simulator(&row(0.0, 20)), 0.0);
+        assert_eq!(
+            expected_abs_error_of_a_perfect_simulator(&row(1.0, 20)),
+            0.0
+        );
+        assert_eq!(
+            expected_abs_error_of_a_perfect_simulator(&row(0.0, 20)),
+            0.0
+        );
         // p = 0.5, 10 published and 10 simulated trials: E|X - Y|/10 with
         // X - Y ~ 20-trial binomial shifted by 10, by enumeration.
         let exact: f64 = (0..=20usize)

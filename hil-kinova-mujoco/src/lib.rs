@@ -74,7 +74,9 @@ pub use model::MjcfSource;
 pub use render::{Keyframe, KeyframeRecorder, KeyframeWriter, RenderingEnv, View};
 #[cfg(feature = "physics")]
 pub use sim::{
-    AttemptReport, FREE_DT, PUBLISHED_HOLD, PerceivedTarget, Placement, Simulator, StopReason, MIN_TINES_TOUCHED};
+    AttemptReport, FREE_DT, MIN_TINES_TOUCHED, PUBLISHED_HOLD, PerceivedTarget, Placement,
+    Simulator, StopReason,
+};
 #[cfg(feature = "physics")]
 pub use skewer::{MAX_DT, REF_DT};
 

@@ -26,7 +26,11 @@ fn queries_by_food_and_by_attempt_add_up_to_the_plate_count() {
         assert_eq!(p.n_q_by_attempt.iter().sum::<usize>(), p.n_q, "{p:?}");
         assert_eq!(p.n_q_by_attempt.len(), cfg.session.n_att as usize);
         // Every food the plate met is listed, asked at or not.
-        assert!(p.n_q_by_food.keys().all(|f| result.protocol.foods.contains(f)));
+        assert!(
+            p.n_q_by_food
+                .keys()
+                .all(|f| result.protocol.foods.contains(f))
+        );
         asked_somewhere |= p.n_q > 0;
     }
     assert!(asked_somewhere, "AlwaysQuery asks on every plate");

@@ -79,9 +79,12 @@ pub struct SettingCell {
     pub setting: Setting,
     /// Trials run.
     pub trials: usize,
+    /// Trials discarded under the published rule (fewer than
+    /// [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines touched the item).
+    pub discarded: usize,
     /// Successes.
     pub successes: usize,
-    /// Achieved success rate.
+    /// Achieved success rate over the trials that counted.
     pub rate: f64,
     /// Binomial standard error of `rate`, √(p(1−p)/n).
     pub se: f64,
@@ -98,9 +101,12 @@ pub struct CalibrationRow {
     pub action: String,
     /// Trials run.
     pub trials: usize,
+    /// Trials discarded under the published rule (fewer than
+    /// [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines touched the item).
+    pub discarded: usize,
     /// Successes.
     pub successes: usize,
-    /// Achieved success rate.
+    /// Achieved success rate over the trials that counted.
     pub rate: f64,
     /// Binomial standard error of `rate`, √(p(1−p)/n).
     pub se: f64,
@@ -138,6 +144,14 @@ pub struct CalibrationReport {
     pub max_abs_error: f64,
     /// Mean absolute difference per setting cell.
     pub mean_abs_error_by_setting: f64,
+    /// The mean absolute difference a *perfect* simulator would be expected
+    /// to show over the same overall rows: one whose true rate in every
+    /// setting is the published one, so that only the sampling noise of
+    /// both tables remains (the published cells rest on
+    /// [`PUBLISHED_TRIALS_PER_SETTING`] trials per setting; the simulated
+    /// ones on the trials counted here). The floor `mean_abs_error` is to
+    /// be read against.
+    pub noise_floor: f64,
     /// How long an item had to stay on the lifted fork (s).
     pub hold_s: f64,
     /// What turned the tine row by the actions' roll.
@@ -286,7 +300,14 @@ pub fn calibrate_with(
         .iter()
         .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
         .fold(0.0, f64::max);
+    let noise_floor = mean(
+        rows.iter()
+            .filter(|r| r.published.is_some())
+            .map(expected_abs_error_of_a_perfect_simulator)
+            .collect(),
+    );
     Ok(CalibrationReport {
+        noise_floor,
         max_abs_error,
         hold_s,
         roll_by: opts.roll_by,
@@ -315,6 +336,61 @@ pub fn calibrate_with(
     })
 }
 
+/// Trials per (food, action, setting) behind the published rates (Feng et
+/// al. 2019: 10 per setting, 30 per overall cell).
+pub const PUBLISHED_TRIALS_PER_SETTING: usize = 10;
+
+/// The expected |simulated − published| of `row` for a simulator whose
+/// true rate in every setting equals the published one: the overall
+/// published rate is the sum of [`PUBLISHED_TRIALS_PER_SETTING`]-trial
+/// binomials over the row's settings, the simulated one the sum of
+/// binomials over the trials counted per setting; both distributions are
+/// enumerated exactly.
+pub fn expected_abs_error_of_a_perfect_simulator(row: &CalibrationRow) -> f64 {
+    let sum_of = |trials: &dyn Fn(&SettingCell) -> usize| -> Vec<f64> {
+        row.by_setting.iter().fold(vec![1.0], |dist, c| {
+            convolve(&dist, &binomial_pmf(trials(c), c.published.unwrap_or(0.0)))
+        })
+    };
+    let published = sum_of(&|_| PUBLISHED_TRIALS_PER_SETTING);
+    let simulated = sum_of(&|c| c.trials - c.discarded);
+    let (np, ns) = (published.len() - 1, simulated.len() - 1);
+    if np == 0 || ns == 0 {
+        return 0.0;
+    }
+    let mut e = 0.0;
+    for (i, pi) in published.iter().enumerate() {
+        for (j, pj) in simulated.iter().enumerate() {
+            e += pi * pj * (i as f64 / np as f64 - j as f64 / ns as f64).abs();
+        }
+    }
+    e
+}
+
+/// Probabilities of 0..=n successes in n trials at rate p.
+fn binomial_pmf(n: usize, p: f64) -> Vec<f64> {
+    let mut out = Vec::with_capacity(n + 1);
+    let mut c = 1.0; // n choose k, built up as k grows
+    for k in 0..=n {
+        if k > 0 {
+            c *= (n - k + 1) as f64 / k as f64;
+        }
+        out.push(c * p.powi(k as i32) * (1.0 - p).powi((n - k) as i32));
+    }
+    out
+}
+
+/// The distribution of the sum of two independent counts.
+fn convolve(a: &[f64], b: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; a.len() + b.len() - 1];
+    for (i, x) in a.iter().enumerate() {
+        for (j, y) in b.iter().enumerate() {
+            out[i + j] += x * y;
+        }
+    }
+    out
+}
+
 /// Binomial standard error of a rate of `successes` in `trials`.
 pub fn binomial_se(successes: usize, trials: usize) -> f64 {
     if trials == 0 {
@@ -326,6 +402,19 @@ pub fn binomial_se(successes: usize, trials: usize) -> f64 {
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Trials, discarded trials and successes among `records`: an attempt in
+/// which fewer than [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines
+/// touched the item is discarded, as in the published data set, and counts
+/// neither way.
+fn count(records: &[&&AttemptRecord]) -> (usize, usize, usize) {
+    let discarded = records.iter().filter(|r| !r.report.counted).count();
+    let successes = records
+        .iter()
+        .filter(|r| r.report.counted && r.report.success)
+        .count();
+    (records.len(), discarded, successes)
 }
 
 /// Groups attempt records into rows per (food, action), in job order.
@@ -341,23 +430,23 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                 .settings
                 .iter()
                 .map(|&setting| {
-                    let trials = cell.iter().filter(|r| r.setting == setting).count();
-                    let successes = cell
-                        .iter()
-                        .filter(|r| r.setting == setting && r.report.success)
-                        .count();
+                    let here: Vec<&&AttemptRecord> =
+                        cell.iter().filter(|r| r.setting == setting).collect();
+                    let (trials, discarded, successes) = count(&here);
+                    let counted = trials - discarded;
                     SettingCell {
                         setting,
                         trials,
+                        discarded,
                         successes,
-                        rate: successes as f64 / trials.max(1) as f64,
-                        se: binomial_se(successes, trials),
+                        rate: successes as f64 / counted.max(1) as f64,
+                        se: binomial_se(successes, counted),
                         published: Some(food.published_rates_in(setting)[a]),
                     }
                 })
                 .collect();
-            let trials = cell.len();
-            let successes = cell.iter().filter(|r| r.report.success).count();
+            let (trials, discarded, successes) = count(&cell.iter().collect::<Vec<_>>());
+            let counted = trials - discarded;
             // With all three settings equally represented the published
             // `all` row applies; otherwise the trial-weighted mean of the
             // settings run.
@@ -378,13 +467,122 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                 food: food.name().into(),
                 action: action.name.into(),
                 trials,
+                discarded,
                 successes,
-                rate: successes as f64 / trials.max(1) as f64,
-                se: binomial_se(successes, trials),
+                rate: successes as f64 / counted.max(1) as f64,
+                se: binomial_se(successes, counted),
                 published,
                 by_setting,
             });
         }
     }
     rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::StopReason;
+    use crate::skewer::SkewerStats;
+
+    fn record(setting: Setting, touched: usize, success: bool) -> AttemptRecord {
+        AttemptRecord {
+            food: FoodKind::Banana,
+            setting,
+            trial: 0,
+            seed: 0,
+            report: AttemptReport {
+                action: ACTIONS[0].name,
+                food: FoodKind::Banana,
+                success,
+                reached_pitch: 0.0,
+                reached_gamma: 0.0,
+                reached_roll: 0.0,
+                handle_roll: 0.0,
+                stop: StopReason::Force,
+                peak_force: 0.0,
+                tines: SkewerStats {
+                    touched,
+                    ..SkewerStats::default()
+                },
+                push_shift: 0.0,
+                push_tilt: 0.0,
+                counted: touched >= crate::sim::MIN_TINES_TOUCHED,
+                final_height: 0.0,
+                lifted_height: 0.0,
+                hold_slip: 0.0,
+                sim_time: 0.0,
+                steps: 0,
+            },
+        }
+    }
+
+    #[test]
+    fn a_perfect_simulator_still_differs_by_the_sampling_noise() {
+        let cell = |published: f64, trials: usize| SettingCell {
+            setting: Setting::Isolated,
+            trials,
+            discarded: 0,
+            successes: 0,
+            rate: 0.0,
+            se: 0.0,
+            published: Some(published),
+        };
+        let row = |published: f64, trials: usize| CalibrationRow {
+            food: "banana".into(),
+            action: "VS0".into(),
+            trials,
+            discarded: 0,
+            successes: 0,
+            rate: 0.0,
+            se: 0.0,
+            published: Some(published),
+            by_setting: vec![cell(published, trials)],
+        };
+        // Certain outcomes leave no noise.
+        assert_eq!(
+            expected_abs_error_of_a_perfect_simulator(&row(1.0, 20)),
+            0.0
+        );
+        assert_eq!(
+            expected_abs_error_of_a_perfect_simulator(&row(0.0, 20)),
+            0.0
+        );
+        // p = 0.5, 10 published and 10 simulated trials: E|X - Y|/10 with
+        // X - Y ~ 20-trial binomial shifted by 10, by enumeration.
+        let exact: f64 = (0..=20usize)
+            .map(|k| {
+                let c = (1..=k).fold(1.0, |c, i| c * (20 - i + 1) as f64 / i as f64);
+                c * 0.5f64.powi(20) * (k as f64 - 10.0).abs() / 10.0
+            })
+            .sum();
+        let e = expected_abs_error_of_a_perfect_simulator(&row(0.5, 10));
+        assert!((e - exact).abs() < 1e-12, "{e} vs {exact}");
+        // More simulated trials shrink it, but not below the published noise.
+        let more = expected_abs_error_of_a_perfect_simulator(&row(0.5, 1000));
+        assert!(more < e && more > 0.1, "{more}");
+    }
+
+    #[test]
+    fn attempts_with_fewer_than_two_tines_touching_are_discarded_not_failed() {
+        let opts = CalibrationOptions {
+            foods: vec![FoodKind::Banana],
+            settings: vec![Setting::Isolated],
+            trials: 4,
+            ..CalibrationOptions::default()
+        };
+        let records = [
+            record(Setting::Isolated, 4, true),
+            record(Setting::Isolated, 3, false),
+            record(Setting::Isolated, 1, false),
+            record(Setting::Isolated, 0, false),
+        ];
+        let rows = tabulate(&opts, &records);
+        let vs0 = &rows[0];
+        assert_eq!((vs0.trials, vs0.discarded, vs0.successes), (4, 2, 1));
+        assert_eq!(vs0.rate, 0.5);
+        assert_eq!(vs0.se, binomial_se(1, 2));
+        assert_eq!(vs0.by_setting[0].discarded, 2);
+        assert_eq!(vs0.by_setting[0].rate, 0.5);
+    }
 }

@@ -22,11 +22,11 @@ use hil_envs::feeding::{FeedingTask, FoodFacts};
 /// that are not on the plate, as the paper did. A derived kind is one of
 /// the 16 published foods and takes from the feeding data its name,
 /// description, published rates and expert answer, and its own colour; its
-/// shape and mechanics are those of its base kind ([`FoodKind::base`]),
-/// unchanged, and it is staged in its base kind's body. Its simulated
-/// success rates are therefore its base kind's, **not calibrated** to the
-/// published rates of the food it is named after (`hil kinova calibrate
-/// --foods honeydew,kiwi,celery` shows both).
+/// shape is that of its base kind ([`FoodKind::base`]) and it is staged in
+/// its base kind's body; its mechanics are the base kind's with the
+/// properties that set it apart calibrated to its own published rates
+/// ([`FoodModel::default_for`]; `hil kinova calibrate --foods
+/// honeydew,kiwi,celery` shows both).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
 #[serde(rename_all = "snake_case")]
 pub enum FoodKind {
@@ -36,11 +36,11 @@ pub enum FoodKind {
     Carrot,
     /// A cantaloupe cube: medium, juicy.
     Cantaloupe,
-    /// A honeydew cube, derived from cantaloupe (not calibrated).
+    /// A honeydew cube, derived from cantaloupe (its flesh).
     Honeydew,
-    /// A kiwi slice, derived from banana (not calibrated).
+    /// A kiwi slice, derived from banana (firmer, grips better).
     Kiwi,
-    /// A celery piece, derived from carrot (not calibrated).
+    /// A celery piece, derived from carrot (pierced more easily).
     Celery,
 }
 
@@ -69,7 +69,7 @@ impl FoodKind {
         }
     }
 
-    /// Whether this kind is derived from another (not calibrated).
+    /// Whether this kind is derived from another (shares its shape and body).
     pub fn is_derived(self) -> bool {
         self.base() != self
     }
@@ -450,6 +450,10 @@ pub struct FoodProps {
     pub friction: f64,
     /// Lateral load the flesh bears before a tine tears out (N per metre embedded).
     pub tear_per_m: f64,
+    /// Friction coefficient of the item on the plate and its rim (a wet
+    /// slice slides more easily than a dry stick): whether an angled push
+    /// slides the item away before the tines are in.
+    pub plate_friction: f64,
     /// Sideways slot a tine may cut before it tears out (m).
     pub cut_limit: f64,
     /// True colour (RGB).
@@ -482,6 +486,8 @@ pub struct FoodModel {
     pub friction: (f64, f64),
     /// Mean tear strength (N/m) and relative sd.
     pub tear_per_m: (f64, f64),
+    /// Friction coefficient on the plate (mean, relative sd).
+    pub plate_friction: (f64, f64),
     /// Sideways slot before a tine tears out, as a fraction of the item's
     /// minor half-extent.
     pub cut_fraction_of_width: f64,
@@ -491,10 +497,31 @@ impl FoodModel {
     /// The built-in (calibrated) model of `kind`.
     pub fn default_for(kind: FoodKind) -> Self {
         if kind.is_derived() {
-            // The base kind's distributions, unchanged (see FoodKind).
-            return FoodModel {
-                kind,
-                ..Self::default_for(kind.base())
+            // The base kind's shape and distributions, with the mechanical
+            // properties that set this food apart calibrated to its own
+            // published rates (see FoodKind).
+            let base = Self::default_for(kind.base());
+            return match kind {
+                // Melon like cantaloupe: the same flesh.
+                FoodKind::Honeydew => FoodModel { kind, ..base },
+                // A kiwi slice is firmer than banana and its seeds and
+                // core grip a tine: more puncture force, grip and tear
+                // strength.
+                FoodKind::Kiwi => FoodModel {
+                    kind,
+                    puncture_force: (0.8, 0.3),
+                    grip_per_m: (1.0, 0.5),
+                    tear_per_m: (30.0, 0.3),
+                    ..base
+                },
+                // Celery's fibres part far more easily than a carrot's
+                // flesh: four tines pierce it within VS's and TV's limits.
+                FoodKind::Celery => FoodModel {
+                    kind,
+                    puncture_force: (3.5, 0.15),
+                    ..base
+                },
+                _ => base,
             };
         }
         match kind {
@@ -509,6 +536,7 @@ impl FoodModel {
                 grip_per_m: (0.3, 0.5),
                 friction: (1.1, 0.3),
                 tear_per_m: (22.0, 0.3),
+                plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.3,
             },
             FoodKind::Carrot => FoodModel {
@@ -522,6 +550,7 @@ impl FoodModel {
                 grip_per_m: (60.0, 0.3),
                 friction: (0.8, 0.2),
                 tear_per_m: (1500.0, 0.3),
+                plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.5,
             },
             FoodKind::Cantaloupe => FoodModel {
@@ -535,6 +564,7 @@ impl FoodModel {
                 grip_per_m: (1.5, 0.5),
                 friction: (0.8, 0.3),
                 tear_per_m: (200.0, 0.3),
+                plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.4,
             },
             FoodKind::Honeydew | FoodKind::Kiwi | FoodKind::Celery => {
@@ -586,6 +616,7 @@ impl FoodModel {
             grip_per_m: pos(self.grip_per_m.0, self.grip_per_m.1),
             friction: pos(self.friction.0, self.friction.1),
             tear_per_m: pos(self.tear_per_m.0, self.tear_per_m.1),
+            plate_friction: pos(self.plate_friction.0, self.plate_friction.1),
             cut_limit: self.cut_fraction_of_width * shape.half_extents()[1],
             colour: self.kind.colour(),
         }

@@ -53,8 +53,9 @@ mod without_physics;
 
 #[cfg(feature = "physics")]
 pub use calibrate::{
-    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow, SettingCell, calibrate,
-    calibrate_with,
+    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow,
+    PUBLISHED_TRIALS_PER_SETTING, SettingCell, calibrate, calibrate_with,
+    expected_abs_error_of_a_perfect_simulator,
 };
 #[cfg(feature = "physics")]
 pub use controller::{ACTIONS, Action, RollBy};
@@ -73,7 +74,8 @@ pub use model::MjcfSource;
 pub use render::{Keyframe, KeyframeRecorder, KeyframeWriter, RenderingEnv, View};
 #[cfg(feature = "physics")]
 pub use sim::{
-    AttemptReport, FREE_DT, PUBLISHED_HOLD, PerceivedTarget, Placement, Simulator, StopReason,
+    AttemptReport, FREE_DT, MIN_TINES_TOUCHED, PUBLISHED_HOLD, PerceivedTarget, Placement,
+    Simulator, StopReason,
 };
 #[cfg(feature = "physics")]
 pub use skewer::{MAX_DT, REF_DT};

@@ -39,6 +39,9 @@ const LIFTED: f64 = 0.03;
 /// cut and tear, run at the model's own step (at most [`REF_DT`]); a long
 /// step is also cut back to that whenever a tine is indenting.
 pub const FREE_DT: f64 = MAX_DT;
+/// Fewest tines that must touch the item for an attempt to count
+/// (Feng et al. 2019: attempts where fewer touched are discarded).
+pub const MIN_TINES_TOUCHED: usize = 2;
 /// Simulated time the items settle after staging (s).
 const SETTLE_TIME: f64 = 0.15;
 
@@ -125,6 +128,18 @@ pub struct AttemptReport {
     pub peak_force: f64,
     /// Tine counters.
     pub tines: SkewerStats,
+    /// How far the item moved across the plate (horizontally) from the
+    /// pre-pose to the end of penetration (m): an angled push that slides
+    /// it away shows here.
+    pub push_shift: f64,
+    /// How far the item tipped (angle of its body z axis from vertical)
+    /// by the end of penetration (rad).
+    pub push_tilt: f64,
+    /// The attempt counts under the published rule: at least
+    /// [`MIN_TINES_TOUCHED`] tines touched the item (Feng et al. 2019
+    /// discard attempts where fewer did; they are neither successes nor
+    /// failures).
+    pub counted: bool,
     /// Height of the item above the plate at the end (m).
     pub final_height: f64,
     /// Height of the item above the plate when the hold began (m).
@@ -515,6 +530,9 @@ impl Simulator {
         // no count, address or array size of the model is touched.
         let m = unsafe { self.data.model_mut() };
         m.geom_size_mut()[f.geom] = size;
+        // The plate's own friction is set below every food's (MJCF), so
+        // MuJoCo's rule (the larger of the two) makes the item's govern.
+        m.geom_friction_mut()[f.geom][0] = p.plate_friction;
         m.geom_aabb_mut()[f.geom] = [0.0, 0.0, 0.0, aabb[0], aabb[1], aabb[2]];
         m.geom_rbound_mut()[f.geom] = p.shape.bounding_radius();
         m.body_mass_mut()[f.body] = p.mass;
@@ -683,6 +701,8 @@ impl Simulator {
         let reached_roll = self.row_angle_to(perceived.yaw);
         let handle_roll = self.handle_angle_to(perceived.yaw);
         let tare = self.wrist_force();
+        let b = self.ids.food[target.slot()].body;
+        let item_at_pre = Vector3::from(self.data.xpos()[b]);
         if let Some(k) = keyframe.as_mut() {
             k("pre_pose", &mut self.data);
         }
@@ -721,6 +741,10 @@ impl Simulator {
             }
         }
         self.check_finite("penetration")?;
+        let moved = Vector3::from(self.data.xpos()[b]) - item_at_pre;
+        let push_shift = moved.x.hypot(moved.y);
+        // xmat row-major: element 8 is the z component of the body z axis.
+        let push_tilt = self.data.xmat()[b][8].clamp(-1.0, 1.0).acos();
         if let Some(k) = keyframe.as_mut() {
             k("skewer", &mut self.data);
         }
@@ -745,7 +769,6 @@ impl Simulator {
         if let Some(k) = keyframe.as_mut() {
             k("lift", &mut self.data);
         }
-        let b = self.ids.food[target.slot()].body;
         let lifted_height = self.data.xpos()[b][2] - self.plate_top_centre().z;
         let slip_at_lift = skewer.stats.slip_m;
         self.advance(&mut skewer, self.hold, self.free_dt)?;
@@ -769,6 +792,9 @@ impl Simulator {
             stop,
             peak_force: peak,
             tines: skewer.stats,
+            push_shift,
+            push_tilt,
+            counted: skewer.stats.touched >= MIN_TINES_TOUCHED,
             final_height: height,
             lifted_height,
             hold_slip: skewer.stats.slip_m - slip_at_lift,

@@ -271,6 +271,17 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         report.micros_per_step,
         100.0 * report.overhead_share
     );
+    println!(
+        "a perfect simulator (true rates = the published ones) would still average {:.3}: the sampling noise of {} published trials per setting and of these",
+        report.noise_floor,
+        hil_kinova_mujoco::PUBLISHED_TRIALS_PER_SETTING
+    );
+    let discarded: usize = report.rows.iter().map(|r| r.discarded).sum();
+    println!(
+        "{discarded} of {} attempts discarded (fewer than {} tines touched the item, as in the published data set); rates are over the rest",
+        report.rows.iter().map(|r| r.trials).sum::<usize>(),
+        hil_kinova_mujoco::MIN_TINES_TOUCHED
+    );
     Ok(())
 }
 
@@ -526,6 +537,23 @@ fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
             pm(s.n_q_per_plate, s.n_q_per_plate_sem, 2),
             s.plates
         );
+        let foods: Vec<String> = s
+            .n_q_by_food
+            .iter()
+            .map(|(f, q)| format!("{f} {q:.2}"))
+            .collect();
+        let attempts: Vec<String> = s
+            .n_q_by_attempt
+            .iter()
+            .enumerate()
+            .map(|(i, q)| format!("#{} {q:.2}", i + 1))
+            .collect();
+        println!(
+            "{:<12} asks per plate at {}; at attempt {}",
+            "",
+            foods.join(", "),
+            attempts.join(", ")
+        );
     }
     Ok(())
 }
@@ -533,7 +561,7 @@ fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
 /// `hil demo kinova --seeds N`: the whole study on N consecutive master
 /// seeds (in parallel), every figure as mean ± standard error over seeds.
 fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
-    use hil_experiments::user_study::mean_sem;
+    use hil_experiments::user_study::{MeanSem, mean_sem};
     if args.render.is_some() {
         return Err(HilError::invalid_parameter(
             "--render",
@@ -584,13 +612,55 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
         mean_sem(&xs)
     };
     let labels: Vec<String> = runs[0].methods.iter().map(|m| m.method.clone()).collect();
+    // Where each method asks: per food and per attempt index, mean ± SE
+    // over seeds of each seed's mean per plate.
+    let asks = |label: &str| -> (Vec<(String, MeanSem)>, Vec<MeanSem>) {
+        let mine: Vec<&hil_experiments::user_study::MethodSummary> = runs
+            .iter()
+            .filter_map(|r| r.methods.iter().find(|m| m.method == label))
+            .collect();
+        let mut foods: Vec<String> = mine
+            .iter()
+            .flat_map(|m| m.n_q_by_food.keys().cloned())
+            .collect();
+        foods.sort();
+        foods.dedup();
+        let by_food = foods
+            .into_iter()
+            .map(|f| {
+                let xs: Vec<f64> = mine
+                    .iter()
+                    .map(|m| m.n_q_by_food.get(&f).copied().unwrap_or(0.0))
+                    .collect();
+                (f, mean_sem(&xs))
+            })
+            .collect();
+        let depth = mine
+            .iter()
+            .map(|m| m.n_q_by_attempt.len())
+            .max()
+            .unwrap_or(0);
+        let by_attempt = (0..depth)
+            .map(|i| {
+                let xs: Vec<f64> = mine
+                    .iter()
+                    .map(|m| m.n_q_by_attempt.get(i).copied().unwrap_or(0.0))
+                    .collect();
+                mean_sem(&xs)
+            })
+            .collect();
+        (by_food, by_attempt)
+    };
     let mut rows = Vec::new();
     for label in &labels {
+        let (by_food, by_attempt) = asks(label);
         rows.push(serde_json::json!({
             "method": label,
             "r_task_avg": per(label, |m| m.r_task_avg),
             "n_success_per_plate": per(label, |m| m.n_success_per_plate),
             "n_q_per_plate": per(label, |m| m.n_q_per_plate),
+            "n_q_per_plate_by_food": by_food.into_iter().collect::<std::collections::BTreeMap<_, _>>(),
+            "n_q_per_plate_by_attempt": by_attempt,
             "paper": PAPER_STUDY.iter().find(|p| p.0 == label).map(|p| [p.1, p.2, p.3]),
         }));
     }
@@ -643,6 +713,25 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
             pm(r.mean, r.sem, 3),
             pm(s.mean, s.sem, 2),
             pm(q.mean, q.sem, 2)
+        );
+    }
+    println!("where each method asks: queries per plate at each food, and at each attempt index");
+    for label in &labels {
+        let (by_food, by_attempt) = asks(label);
+        let foods: Vec<String> = by_food
+            .iter()
+            .map(|(f, m)| format!("{f} {}", pm(m.mean, m.sem, 2)))
+            .collect();
+        let attempts: Vec<String> = by_attempt
+            .iter()
+            .enumerate()
+            .map(|(i, m)| format!("#{} {}", i + 1, pm(m.mean, m.sem, 2)))
+            .collect();
+        println!(
+            "{:<12} {}; attempt {}",
+            label,
+            foods.join(", "),
+            attempts.join(", ")
         );
     }
     let mut methods: Vec<&String> = chosen.iter().map(|c| &c.0).collect();

@@ -60,6 +60,23 @@ tune = { w = [0.5, 8.0] }
         }
     }
     assert_eq!(methods[1]["n_q_per_plate"]["mean"], 3.0);
+    // Where each method asks adds up to how often it asks.
+    for m in methods {
+        let total = m["n_q_per_plate"]["mean"].as_f64().unwrap();
+        let by_food = m["n_q_per_plate_by_food"].as_object().unwrap();
+        assert_eq!(by_food.len(), 3, "{m}");
+        let food_sum: f64 = by_food.values().map(|v| v["mean"].as_f64().unwrap()).sum();
+        let attempt_sum: f64 = m["n_q_per_plate_by_attempt"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v["mean"].as_f64().unwrap())
+            .sum();
+        assert!(
+            (food_sum - total).abs() < 1e-9 && (attempt_sum - total).abs() < 1e-9,
+            "{m}"
+        );
+    }
     assert_eq!(methods[2]["paper"], serde_json::json!([0.68, 2.53, 1.74]));
     let selections = v["selections"].as_array().unwrap();
     assert_eq!(selections.len(), 3);

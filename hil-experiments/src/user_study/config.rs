@@ -124,9 +124,9 @@ pub const PAPER_W_GRID: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
 const PAPER_PRETRAINING_TRIALS: usize = 10;
 /// The foods of the pretraining attempts: none of them is on the plate, as
 /// in the paper. They are derived kinds (`hil_kinova_mujoco::FoodKind`):
-/// published foods with their own colour and their base kind's mechanics
-/// (honeydew from cantaloupe, kiwi from banana, celery from carrot), not
-/// calibrated to the published rates of the foods they are named after.
+/// published foods with their own colour, their base kind's shape
+/// (honeydew from cantaloupe, kiwi from banana, celery from carrot) and
+/// mechanics calibrated to their own published rates.
 pub const PAPER_PRETRAIN_FOODS: [&str; 3] = ["honeydew", "kiwi", "celery"];
 /// The workload model of the study: the paper's simulation model over the
 /// 12 query variables, whose weights are positive, so its forecast never

@@ -1,5 +1,6 @@
 //! Running the study: the plate schedule, the built methods, the results.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -68,6 +69,13 @@ pub struct PlateResult {
     pub n_success: usize,
     /// Queries asked.
     pub n_q: usize,
+    /// Queries asked per food (item label): where the method asks.
+    #[serde(default)]
+    pub n_q_by_food: BTreeMap<String, usize>,
+    /// Queries asked per attempt index at an item (0-based: index 0 counts
+    /// queries at first attempts): when the method asks.
+    #[serde(default)]
+    pub n_q_by_attempt: Vec<usize>,
     /// Steps (attempts) taken.
     pub n_steps: usize,
     /// Change of workload over the plate, ΔWL.
@@ -142,6 +150,13 @@ pub struct MethodSummary {
     pub n_q_per_plate: f64,
     /// Its standard error.
     pub n_q_per_plate_sem: Option<f64>,
+    /// Mean queries per plate at each food's items (every food met in
+    /// any of the method's plates; 0 on a plate that asked none there).
+    #[serde(default)]
+    pub n_q_by_food: BTreeMap<String, f64>,
+    /// Mean queries per plate at each attempt index (0-based).
+    #[serde(default)]
+    pub n_q_by_attempt: Vec<f64>,
 }
 
 impl MethodSummary {
@@ -151,6 +166,27 @@ impl MethodSummary {
         let r = col(|p| p.r_task_avg);
         let s = col(|p| p.n_success as f64);
         let q = col(|p| p.n_q as f64);
+        let n = plates.len().max(1) as f64;
+        let mut n_q_by_food = BTreeMap::new();
+        for p in plates {
+            for (food, &k) in &p.n_q_by_food {
+                *n_q_by_food.entry(food.clone()).or_insert(0.0) += k as f64 / n;
+            }
+        }
+        let depth = plates
+            .iter()
+            .map(|p| p.n_q_by_attempt.len())
+            .max()
+            .unwrap_or(0);
+        let n_q_by_attempt = (0..depth)
+            .map(|i| {
+                plates
+                    .iter()
+                    .map(|p| p.n_q_by_attempt.get(i).copied().unwrap_or(0) as f64)
+                    .sum::<f64>()
+                    / n
+            })
+            .collect();
         Self {
             method: method.to_string(),
             plates: plates.len(),
@@ -160,6 +196,8 @@ impl MethodSummary {
             n_success_per_plate_sem: s.sem,
             n_q_per_plate: q.mean,
             n_q_per_plate_sem: q.sem,
+            n_q_by_food,
+            n_q_by_attempt,
         }
     }
 }
@@ -370,9 +408,21 @@ impl UserStudy<'_> {
             if let Some(name) = name {
                 env_name = name;
             }
+            let mut n_q_by_food = BTreeMap::new();
+            let mut n_q_by_attempt = vec![0usize; cfg.session.n_att as usize];
             for e in &report.events {
                 if !foods.contains(&e.step.item_label) {
                     foods.push(e.step.item_label.clone());
+                }
+                // Every food on the plate appears, asked at or not.
+                let at_food = n_q_by_food.entry(e.step.item_label.clone()).or_insert(0);
+                if e.step.decision.is_query() {
+                    *at_food += 1;
+                    let i = e.step.attempt as usize;
+                    if i >= n_q_by_attempt.len() {
+                        n_q_by_attempt.resize(i + 1, 0);
+                    }
+                    n_q_by_attempt[i] += 1;
                 }
             }
             let m = &report.metrics;
@@ -383,6 +433,8 @@ impl UserStudy<'_> {
                 r_task_avg: m.r_task_avg,
                 n_success: m.n_success,
                 n_q: m.n_q,
+                n_q_by_food,
+                n_q_by_attempt,
                 n_steps: m.n_steps,
                 delta_wl: m.delta_wl,
             };

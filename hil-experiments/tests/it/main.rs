@@ -9,3 +9,5 @@ mod user_study;
 mod user_study_plugins;
 #[cfg(feature = "physics")]
 mod user_study_selection;
+#[cfg(feature = "physics")]
+mod user_study_where_asked;

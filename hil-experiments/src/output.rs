@@ -2,6 +2,7 @@
 //! figures.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use hil_core::{HilError, Result};
 use serde::Serialize;
@@ -9,7 +10,7 @@ use serde::Serialize;
 use crate::plot::{frontier_svg, rollout_svg, workload_comparison_svg};
 use crate::report::tables_markdown;
 use crate::results::Reproduction;
-use crate::testbed::{NamedModel, Phase, RunRecord};
+use crate::testbed::{NamedModel, Phase, Protocol, RunRecord};
 
 /// Where the time went.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -43,6 +44,16 @@ pub struct Written {
     pub figures: Vec<PathBuf>,
 }
 
+impl Written {
+    /// Every file written: `results.json`, `tables.md`, then the figures.
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        [&self.results, &self.tables]
+            .into_iter()
+            .chain(&self.figures)
+            .map(PathBuf::as_path)
+    }
+}
+
 fn write(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|e| HilError::io("writing", path, e))
 }
@@ -67,7 +78,46 @@ pub fn write_outputs(
     models: &[NamedModel],
     timing: &Timing,
 ) -> Result<Written> {
-    std::fs::create_dir_all(dir).map_err(|e| HilError::io("creating", dir, e))?;
+    let (tables, figures) = write_tables_and_figures(dir, reproduction, records, models, timing)?;
+    let results = write_results(dir, reproduction, timing)?;
+    Ok(Written {
+        results,
+        tables,
+        figures,
+    })
+}
+
+/// The selection, aggregation and (with `dir`) output files of `protocol`'s
+/// finished `records`, timed: `timing.report_s` is set to what they took,
+/// so `timing` should hold the caller's setup and run times. `results.json`,
+/// which states the time, is written last, once. What `hil reproduce` and
+/// `hil.reproduce(out=...)` both do after running the jobs.
+pub fn report(
+    protocol: &Protocol,
+    records: &[RunRecord],
+    dir: Option<&Path>,
+    timing: &mut Timing,
+) -> Result<(Reproduction, Option<Written>)> {
+    let start = Instant::now();
+    let reproduction = protocol.reproduction(records)?;
+    let Some(dir) = dir else {
+        timing.report_s = start.elapsed().as_secs_f64();
+        return Ok((reproduction, None));
+    };
+    let (tables, figures) =
+        write_tables_and_figures(dir, &reproduction, records, &protocol.models, timing)?;
+    timing.report_s = start.elapsed().as_secs_f64();
+    let results = write_results(dir, &reproduction, timing)?;
+    let written = Written {
+        results,
+        tables,
+        figures,
+    };
+    Ok((reproduction, Some(written)))
+}
+
+/// Writes `results.json` into `dir`.
+fn write_results(dir: &Path, reproduction: &Reproduction, timing: &Timing) -> Result<PathBuf> {
     let results_path = dir.join("results.json");
     let json = serde_json::to_string_pretty(&ResultsFile {
         results: reproduction,
@@ -76,6 +126,19 @@ pub fn write_outputs(
     })
     .map_err(|e| HilError::serde("results", e))?;
     write(&results_path, &json)?;
+    Ok(results_path)
+}
+
+/// Creates `dir` and writes `tables.md` and the figures into it (everything
+/// [`write_outputs`] writes but `results.json`).
+fn write_tables_and_figures(
+    dir: &Path,
+    reproduction: &Reproduction,
+    records: &[RunRecord],
+    models: &[NamedModel],
+    timing: &Timing,
+) -> Result<(PathBuf, Vec<PathBuf>)> {
+    std::fs::create_dir_all(dir).map_err(|e| HilError::io("creating", dir, e))?;
     let tables = dir.join("tables.md");
     // The time is that of every episode run, so only the run that holds
     // them all (the many-seed one, if any) states it.
@@ -150,9 +213,5 @@ pub fn write_outputs(
         ),
     )?;
     figures.push(frontier);
-    Ok(Written {
-        results: results_path,
-        tables,
-        figures,
-    })
+    Ok((tables, figures))
 }

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use hil_core::HilError;
 use hil_core::plugin::ComponentKind;
-use hil_experiments::output::{Timing, write_outputs};
+use hil_experiments::output::{Timing, report};
 use hil_experiments::testbed::{ModelSource, RunOutcome};
 use hil_experiments::{Method, Protocol, ProtocolSettings};
 use pyo3::prelude::*;
@@ -325,20 +325,13 @@ pub(crate) fn reproduce(
             RunOutcome::Finished(runs) => runs,
             RunOutcome::Cancelled { done, total } => return Ok(Err((done, total))),
         };
-        let runs_s = t1.elapsed().as_secs_f64();
-        let t2 = Instant::now();
-        let reproduction = protocol.reproduction(&runs)?;
-        if let Some(dir) = &out {
-            let threads = rayon_threads();
-            let mut timing = Timing {
-                setup_s,
-                runs_s,
-                report_s: 0.0,
-                threads,
-            };
-            timing.report_s = t2.elapsed().as_secs_f64();
-            write_outputs(dir, &reproduction, &runs, &protocol.models, &timing)?;
-        }
+        let mut timing = Timing {
+            setup_s,
+            runs_s: t1.elapsed().as_secs_f64(),
+            report_s: 0.0,
+            threads: rayon_threads(),
+        };
+        let (reproduction, _) = report(&protocol, &runs, out.as_deref(), &mut timing)?;
         hil_core::Result::Ok(Ok((reproduction, runs)))
     })?;
     let (reproduction, runs) = ran.py_err()?.map_err(cancelled)?;

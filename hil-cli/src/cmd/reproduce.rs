@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use hil_core::HilError;
-use hil_experiments::output::{Timing, write_outputs};
+use hil_experiments::output::{Timing, Written, report};
 use hil_experiments::{Protocol, ProtocolSettings};
 
 /// Arguments of `hil reproduce`.
@@ -78,7 +78,7 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         }
     }
     let protocol = Protocol::from_settings(settings)?;
-    let (settings, dataset, models) = (&protocol.settings, &protocol.dataset, &protocol.models);
+    let (settings, dataset) = (&protocol.settings, &protocol.dataset);
     let (pool, threads) = super::worker_pool(args.threads)?;
     let total = protocol.jobs()?.len();
     let setup_s = t0.elapsed().as_secs_f64();
@@ -99,18 +99,13 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
     bar.finish_and_clear();
     let runs_s = t1.elapsed().as_secs_f64();
 
-    let t2 = Instant::now();
-    let reproduction = protocol.reproduction(&records)?;
     let mut timing = Timing {
         setup_s,
         runs_s,
         report_s: 0.0,
         threads,
     };
-    // Write once to measure, then again with the report time included.
-    write_outputs(&args.out, &reproduction, &records, models, &timing)?;
-    timing.report_s = t2.elapsed().as_secs_f64();
-    let written = write_outputs(&args.out, &reproduction, &records, models, &timing)?;
+    let (reproduction, written) = report(&protocol, &records, Some(&args.out), &mut timing)?;
 
     if !args.quiet {
         eprintln!(
@@ -152,9 +147,7 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
                 }
             }
         }
-        println!("wrote {}", written.results.display());
-        println!("wrote {}", written.tables.display());
-        for f in &written.figures {
+        for f in written.iter().flat_map(Written::paths) {
             println!("wrote {}", f.display());
         }
     }

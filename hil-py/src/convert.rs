@@ -34,6 +34,21 @@ pub(crate) fn from_py<T: DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -
         .py_err()
 }
 
+/// `value` as JSON text (what crosses to Python as a plain string, e.g.
+/// between `hil.sweep`'s processes); an error names `what`.
+pub(crate) fn to_json<T: Serialize + ?Sized>(what: &str, value: &T) -> PyResult<String> {
+    serde_json::to_string(value)
+        .map_err(|e| HilError::serde(what, e))
+        .py_err()
+}
+
+/// JSON text as a `T`; an error names `what`.
+pub(crate) fn from_json<T: DeserializeOwned>(what: &str, json: &str) -> PyResult<T> {
+    serde_json::from_str(json)
+        .map_err(|e| HilError::serde(what, e))
+        .py_err()
+}
+
 /// `json.dumps(obj)`.
 pub(crate) fn json_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
     let json = PyModule::import(obj.py(), "json")?;

@@ -63,9 +63,6 @@ struct GymConfig {
     fallback_arm: usize,
 }
 
-fn parse_json<T: serde::de::DeserializeOwned>(what: &str, json: &str) -> Result<T, HilError> {
-    serde_json::from_str(json).map_err(|e| HilError::serde(what.to_string(), e))
-}
 
 /// What the agent sees when it must decide: the session's decision input.
 #[derive(Clone, Debug)]
@@ -276,7 +273,7 @@ impl GymCore {
     #[new]
     #[pyo3(signature = (config_json, base_dir = "."))]
     fn new(py: Python<'_>, config_json: &str, base_dir: &str) -> PyResult<Self> {
-        let config: GymConfig = parse_json("environment config", config_json).map_err(to_py_err)?;
+        let config: GymConfig = crate::convert::from_json("environment config", config_json)?;
         py.detach(|| Self::build(config, base_dir))
             .map_err(to_py_err)
     }
@@ -413,8 +410,7 @@ impl GymCore {
             }
             None => {
                 if let Some(report) = &engine.report {
-                    let json = serde_json::to_string(&report.metrics)
-                        .map_err(|e| to_py_err(HilError::serde("episode metrics", e)))?;
+                    let json = crate::convert::to_json("episode metrics", &report.metrics)?;
                     info.set_item("episode_json", json)?;
                 }
                 // Gymnasium wants an observation at the end too: the last
@@ -432,7 +428,7 @@ impl GymCore {
     /// forecast workload with this environment's model from its WL_0.
     fn policy(&self, py: Python<'_>, policy_json: &str) -> PyResult<PyPolicyHandle> {
         let config: Box<dyn PolicyConfig> =
-            parse_json("policy config", policy_json).map_err(to_py_err)?;
+            crate::convert::from_json("policy config", policy_json)?;
         let policy = py
             .detach(|| config.validate().and_then(|()| config.build(&self.task)))
             .map_err(to_py_err)?;
@@ -637,8 +633,7 @@ fn pending_info(info: &Bound<'_, PyDict>, p: &Pending) -> PyResult<()> {
 /// `pretrain`, `validation`, `test`, each a list of food names.
 #[pyfunction]
 fn paper_food_split_json() -> PyResult<String> {
-    serde_json::to_string(&hil_envs::FoodSplit::paper())
-        .map_err(|e| to_py_err(HilError::serde("the paper's food split", e)))
+    crate::convert::to_json("the paper's food split", &hil_envs::FoodSplit::paper())
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

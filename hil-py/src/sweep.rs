@@ -19,15 +19,8 @@ use pyo3::types::PyDict;
 
 use crate::reproduce::PythonComponents;
 
+use crate::convert::{from_json, to_json};
 use crate::errors::to_py_err;
-
-fn to_json<T: serde::Serialize>(what: &str, value: &T) -> PyResult<String> {
-    serde_json::to_string(value).map_err(|e| to_py_err(HilError::serde(what.to_string(), e)))
-}
-
-fn from_json<T: serde::de::DeserializeOwned>(what: &str, json: &str) -> PyResult<T> {
-    serde_json::from_str(json).map_err(|e| to_py_err(HilError::serde(what.to_string(), e)))
-}
 
 /// A built protocol and its policies' build context.
 struct Built {

@@ -2,12 +2,29 @@
 
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+from types import ModuleType
 from typing import Any, Dict, List, Optional
 
 import numpy as np
 import pytest
 
 import hil
+
+# The package's folder (hil-py/), for its scripts: bench/ and examples/.
+PACKAGE_DIR = Path(__file__).resolve().parents[1]
+
+
+def load_script(relative: str) -> ModuleType:
+    """The script at `relative` (under hil-py/) imported as a module, so a
+    test can call its `main(argv)` in this process."""
+    path = PACKAGE_DIR / relative
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
 
 # The paper's test foods and a few pretraining foods of the bundled
 # (synthetic, calibrated) dataset.

@@ -1,18 +1,13 @@
 """The crossing benchmark script runs (tiny size); it times nothing that
 is asserted (speed is measured by running it, see hil-py/README.md)."""
 
-import importlib.util
 import json
-from pathlib import Path
 
-BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_crossing.py"
+from conftest import load_script
 
 
 def test_bench_crossing_runs_at_a_tiny_size(capsys):
-    spec = importlib.util.spec_from_file_location("bench_crossing", BENCH)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    module.main(["--repeats", "2", "--steps", "3", "--evict-mb", "0.5", "--json"])
+    load_script("bench/bench_crossing.py").main(["--repeats", "2", "--steps", "3", "--evict-mb", "0.5", "--json"])
     printed = json.loads(capsys.readouterr().out)
     assert set(printed["us_per_step"]) == {"warm", "evicted"}
     for rows in printed["us_per_step"].values():

@@ -5,20 +5,15 @@ reference agrees with hil's LinUCB on the arm it picks; it times nothing
 (speed is measured by running the benchmark, see hil-py/README.md).
 """
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 
-BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_linucb.py"
+from conftest import load_script
 
 
 def load_bench():
-    spec = importlib.util.spec_from_file_location("bench_linucb", BENCH)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("bench/bench_linucb.py")
 
 
 def test_bench_runs_at_a_tiny_size(capsys):

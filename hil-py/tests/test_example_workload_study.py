@@ -1,21 +1,15 @@
 """The example script runs end to end at a small size and writes its plot."""
 
-import importlib.util
-from pathlib import Path
-
 import pytest
+
+from conftest import load_script
 
 pytest.importorskip("gymnasium")
 pytest.importorskip("matplotlib")
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "workload_study.py"
-
 
 def load_example():
-    spec = importlib.util.spec_from_file_location("workload_study", EXAMPLE)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("examples/workload_study.py")
 
 
 def test_workload_study_example_writes_its_plot(tmp_path):

@@ -63,7 +63,6 @@ struct GymConfig {
     fallback_arm: usize,
 }
 
-
 /// What the agent sees when it must decide: the session's decision input.
 #[derive(Clone, Debug)]
 struct Pending {

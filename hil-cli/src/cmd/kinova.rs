@@ -295,14 +295,6 @@ const NOTE: &str = "simulation of the user-study protocol; food properties are s
                     calibrated to published success rates, and the workload model is a \
                     bundled synthetic one: these are not the paper's results";
 
-/// The paper's real-robot user study, per method: r_task_avg, n_success
-/// and n_q per plate (means; Table in the paper's user-study section).
-const PAPER_STUDY: [(&str, f64, f64, f64); 3] = [
-    ("LinUCB", 0.38, 2.00, 0.0),
-    ("AlwaysQuery", 0.87, 2.68, 3.0),
-    ("LinUCB-QG", 0.68, 2.53, 1.74),
-];
-
 /// The study `hil demo kinova` runs: the paper's protocol, changed by
 /// `--components` and then by the flags.
 /// Where the study file's relative paths resolve: its folder, or `.`.
@@ -561,7 +553,7 @@ fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
 /// `hil demo kinova --seeds N`: the whole study on N consecutive master
 /// seeds (in parallel), every figure as mean ± standard error over seeds.
 fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
-    use hil_experiments::user_study::{MeanSem, mean_sem};
+    use hil_experiments::user_study::{across_seeds, mean_sem};
     if args.render.is_some() {
         return Err(HilError::invalid_parameter(
             "--render",
@@ -604,66 +596,7 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
     let mut runs = results.into_inner().unwrap_or_else(|e| e.into_inner());
     runs.sort_by_key(|(i, _)| *i);
     let runs: Vec<UserStudyResult> = runs.into_iter().map(|(_, r)| r).collect::<Result<_>>()?;
-    let per = |label: &str, f: fn(&hil_experiments::user_study::MethodSummary) -> f64| {
-        let xs: Vec<f64> = runs
-            .iter()
-            .filter_map(|r| r.methods.iter().find(|m| m.method == label).map(f))
-            .collect();
-        mean_sem(&xs)
-    };
-    let labels: Vec<String> = runs[0].methods.iter().map(|m| m.method.clone()).collect();
-    // Where each method asks: per food and per attempt index, mean ± SE
-    // over seeds of each seed's mean per plate.
-    let asks = |label: &str| -> (Vec<(String, MeanSem)>, Vec<MeanSem>) {
-        let mine: Vec<&hil_experiments::user_study::MethodSummary> = runs
-            .iter()
-            .filter_map(|r| r.methods.iter().find(|m| m.method == label))
-            .collect();
-        let mut foods: Vec<String> = mine
-            .iter()
-            .flat_map(|m| m.n_q_by_food.keys().cloned())
-            .collect();
-        foods.sort();
-        foods.dedup();
-        let by_food = foods
-            .into_iter()
-            .map(|f| {
-                let xs: Vec<f64> = mine
-                    .iter()
-                    .map(|m| m.n_q_by_food.get(&f).copied().unwrap_or(0.0))
-                    .collect();
-                (f, mean_sem(&xs))
-            })
-            .collect();
-        let depth = mine
-            .iter()
-            .map(|m| m.n_q_by_attempt.len())
-            .max()
-            .unwrap_or(0);
-        let by_attempt = (0..depth)
-            .map(|i| {
-                let xs: Vec<f64> = mine
-                    .iter()
-                    .map(|m| m.n_q_by_attempt.get(i).copied().unwrap_or(0.0))
-                    .collect();
-                mean_sem(&xs)
-            })
-            .collect();
-        (by_food, by_attempt)
-    };
-    let mut rows = Vec::new();
-    for label in &labels {
-        let (by_food, by_attempt) = asks(label);
-        rows.push(serde_json::json!({
-            "method": label,
-            "r_task_avg": per(label, |m| m.r_task_avg),
-            "n_success_per_plate": per(label, |m| m.n_success_per_plate),
-            "n_q_per_plate": per(label, |m| m.n_q_per_plate),
-            "n_q_per_plate_by_food": by_food.into_iter().collect::<std::collections::BTreeMap<_, _>>(),
-            "n_q_per_plate_by_attempt": by_attempt,
-            "paper": PAPER_STUDY.iter().find(|p| p.0 == label).map(|p| [p.1, p.2, p.3]),
-        }));
-    }
+    let rows = across_seeds(&runs);
     let mut chosen = Vec::new();
     for sel in runs.iter().flat_map(|r| &r.selections) {
         chosen.push((sel.method.clone(), sel.parameter.clone(), sel.chosen));
@@ -697,39 +630,35 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
     println!(
         "per method: mean ± standard error over seeds (each seed's mean over its plates); paper's real study in brackets"
     );
-    for label in &labels {
-        let r = per(label, |m| m.r_task_avg);
-        let s = per(label, |m| m.n_success_per_plate);
-        let q = per(label, |m| m.n_q_per_plate);
-        let paper = PAPER_STUDY
-            .iter()
-            .find(|p| p.0 == label)
-            .map_or(String::new(), |p| {
-                format!(" [{:.2} / {:.2} / {:.2}]", p.1, p.2, p.3)
-            });
+    for row in &rows {
+        let paper = row.paper.map_or(String::new(), |p| {
+            format!(" [{:.2} / {:.2} / {:.2}]", p[0], p[1], p[2])
+        });
+        let (r, s, q) = (row.r_task_avg, row.n_success_per_plate, row.n_q_per_plate);
         println!(
             "{:<12} r_task_avg {}  n_success {}  n_q {}{paper}",
-            label,
+            row.method,
             pm(r.mean, r.sem, 3),
             pm(s.mean, s.sem, 2),
             pm(q.mean, q.sem, 2)
         );
     }
     println!("where each method asks: queries per plate at each food, and at each attempt index");
-    for label in &labels {
-        let (by_food, by_attempt) = asks(label);
-        let foods: Vec<String> = by_food
+    for row in &rows {
+        let foods: Vec<String> = row
+            .n_q_per_plate_by_food
             .iter()
             .map(|(f, m)| format!("{f} {}", pm(m.mean, m.sem, 2)))
             .collect();
-        let attempts: Vec<String> = by_attempt
+        let attempts: Vec<String> = row
+            .n_q_per_plate_by_attempt
             .iter()
             .enumerate()
             .map(|(i, m)| format!("#{} {}", i + 1, pm(m.mean, m.sem, 2)))
             .collect();
         println!(
             "{:<12} {}; attempt {}",
-            label,
+            row.method,
             foods.join(", "),
             attempts.join(", ")
         );

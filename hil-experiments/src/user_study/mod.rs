@@ -46,6 +46,7 @@
 
 mod config;
 mod run;
+mod seeds;
 
 pub use config::{
     PAPER_N_ATT, PAPER_VALIDATION_W_TASK, PAPER_W_GRID, PAPER_WORKLOAD, UserStudyConfig, Validation,
@@ -54,3 +55,4 @@ pub use run::{
     Episode, MeanSem, MethodSummary, Plate, PlateResult, Protocol, Selection, UserStudy,
     UserStudyResult, mean_sem, method_order,
 };
+pub use seeds::{MethodAcrossSeeds, PAPER_STUDY, across_seeds};

@@ -55,7 +55,10 @@ pub struct CalibrationOptions {
     pub seed: u64,
     /// Worker threads (each with its own simulator).
     pub threads: usize,
-    /// What turns the tine row by an action's roll.
+    /// The tool. Default [`RollBy::ArmYaw`]: the rigid fork the published
+    /// rates were measured with (Feng et al. 2019), so that only the food
+    /// model is compared; [`RollBy::ForkGamma`] runs the study robot's 2-DoF
+    /// fork on the same foods.
     pub roll_by: RollBy,
 }
 
@@ -67,7 +70,7 @@ impl Default for CalibrationOptions {
             trials: 30,
             seed: 1,
             threads: 1,
-            roll_by: RollBy::default(),
+            roll_by: RollBy::ArmYaw,
         }
     }
 }

@@ -33,7 +33,15 @@ pub struct Action {
     pub roll: f64,
     /// Force threshold ending penetration (N).
     pub max_force: f64,
+    /// Angle of the move-in from vertical (rad), leaning the way the tines
+    /// lean: 0 for VS and TV, whose approach is vertical, and atan(1/2) for
+    /// TA, whose move-in has a vertical component twice the horizontal one
+    /// (ADA's Gen3 skewering, fact sheet §3).
+    pub approach_tilt: f64,
 }
+
+/// TA's move-in: vertical component twice the horizontal (atan(1/2), rad).
+const TA_APPROACH_TILT: f64 = 0.463_647_609_000_806_1;
 
 /// The six actions in hil-core's arm order: VS0 VS90 TV0 TV90 TA0 TA90.
 pub const ACTIONS: [Action; 6] = [
@@ -42,36 +50,42 @@ pub const ACTIONS: [Action; 6] = [
         pitch: 0.0,
         roll: 0.0,
         max_force: 25.0,
+        approach_tilt: 0.0,
     },
     Action {
         name: "VS90",
         pitch: 0.0,
         roll: std::f64::consts::FRAC_PI_2,
         max_force: 25.0,
+        approach_tilt: 0.0,
     },
     Action {
         name: "TV0",
         pitch: -0.5,
         roll: 0.0,
         max_force: 20.0,
+        approach_tilt: 0.0,
     },
     Action {
         name: "TV90",
         pitch: -0.5,
         roll: std::f64::consts::FRAC_PI_2,
         max_force: 20.0,
+        approach_tilt: 0.0,
     },
     Action {
         name: "TA0",
         pitch: 0.4,
         roll: 0.0,
         max_force: 10.0,
+        approach_tilt: TA_APPROACH_TILT,
     },
     Action {
         name: "TA90",
         pitch: 0.4,
         roll: std::f64::consts::FRAC_PI_2,
         max_force: 10.0,
+        approach_tilt: TA_APPROACH_TILT,
     },
 ];
 
@@ -84,9 +98,12 @@ pub enum RollBy {
     /// changes the tines' lean and tilts the tine row.
     #[default]
     ForkGamma,
-    /// The arm turns the whole fork about the vertical, γ stays 0 (a rigid
-    /// fork, as in the data set the published rates come from): the tines'
-    /// lean is the same at 0° and 90°.
+    /// The arm turns the whole fork about the vertical and the fork is
+    /// rigid: γ stays 0 and both fork joints are held by stiff, strong
+    /// servos (the 2-DoF fork's own motors yield under a 20 N push on
+    /// pitched tines). This is the tool of the data set the published rates
+    /// come from (a fork fixed to the arm, rolled by the arm), the default
+    /// of `hil kinova calibrate`; the tines' lean is the same at 0° and 90°.
     ArmYaw,
 }
 
@@ -133,6 +150,19 @@ pub fn fork_roll_orientation(base: &Matrix3<f64>, beta: f64, gamma: f64) -> Matr
 /// towards its +z.
 pub fn tine_direction(base: &Matrix3<f64>, beta: f64, gamma: f64) -> Vector3<f64> {
     fork_roll_orientation(base, beta, gamma) * Vector3::new(TINE_CURVE.cos(), 0.0, TINE_CURVE.sin())
+}
+
+/// Direction of the move-in for `action` with tines along `u`: straight
+/// down tilted by the action's [`Action::approach_tilt`] towards the side
+/// the tines lean (their horizontal part).
+pub fn approach_direction(action: &Action, u: &Vector3<f64>) -> Vector3<f64> {
+    let lean = Vector3::new(u.x, u.y, 0.0);
+    let n = lean.norm();
+    if action.approach_tilt == 0.0 || n < 1e-9 {
+        return -Vector3::z();
+    }
+    let (s, c) = action.approach_tilt.sin_cos();
+    -c * Vector3::z() + s * lean / n
 }
 
 /// Kinematics of the arm on a private copy of the model.
@@ -295,6 +325,28 @@ pub fn min_jerk(t: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn vs_and_tv_move_in_vertically_and_ta_two_down_for_one_across() {
+        for action in &ACTIONS {
+            let u = tine_direction(&fork_base_orientation(0.3), action.pitch, action.roll);
+            let dir = approach_direction(action, &u);
+            assert!((dir.norm() - 1.0).abs() < 1e-12);
+            let across = dir.x.hypot(dir.y);
+            if action.name.starts_with("TA") {
+                // Vertical component twice the horizontal (fact sheet §3),
+                // towards the side the tines lean.
+                assert!(
+                    (-dir.z - 2.0 * across).abs() < 1e-9,
+                    "{}: {dir}",
+                    action.name
+                );
+                assert!(dir.x * u.x + dir.y * u.y > 0.0, "{}", action.name);
+            } else {
+                assert!(across < 1e-12 && dir.z < 0.0, "{}: {dir}", action.name);
+            }
+        }
+    }
 
     #[test]
     fn gamma_turns_the_tines_about_the_pitched_handle() {

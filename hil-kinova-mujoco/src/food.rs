@@ -456,9 +456,18 @@ pub struct FoodProps {
     pub plate_friction: f64,
     /// Sideways slot a tine may cut before it tears out (m).
     pub cut_limit: f64,
+    /// Largest angle between a tine and the surface normal at which the
+    /// tip digs in (rad); a tip meeting the surface more obliquely skids
+    /// along it. A tip sinks at once into soft flesh, so only a steep
+    /// glance skids; on a hard, smooth skin it cannot sink and skids at a
+    /// smaller angle.
+    pub dig_in_angle: f64,
     /// True colour (RGB).
     pub colour: [f64; 3],
 }
+
+/// The dig-in angle of soft flesh (45°): only a steep glance skids.
+const SOFT_DIG_IN: f64 = std::f64::consts::FRAC_PI_4;
 
 /// Parameters of the per-kind property distributions (means and relative
 /// spreads); the calibration knobs of the skewering model.
@@ -491,6 +500,9 @@ pub struct FoodModel {
     /// Sideways slot before a tine tears out, as a fraction of the item's
     /// minor half-extent.
     pub cut_fraction_of_width: f64,
+    /// Largest angle between tine and surface normal at which a tip digs
+    /// in (rad; see [`FoodProps::dig_in_angle`]).
+    pub dig_in_angle: f64,
 }
 
 impl FoodModel {
@@ -538,13 +550,14 @@ impl FoodModel {
                 tear_per_m: (22.0, 0.3),
                 plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.3,
+                dig_in_angle: SOFT_DIG_IN,
             },
             FoodKind::Carrot => FoodModel {
                 kind,
                 dims: vec![0.0085, 0.020],
                 dims_rel_sd: 0.10,
                 density: 1030.0,
-                puncture_force: (7.5, 0.12),
+                puncture_force: (12.5, 0.3),
                 puncture_indent: 0.0022,
                 cut_fraction: 0.25,
                 grip_per_m: (60.0, 0.3),
@@ -552,6 +565,9 @@ impl FoodModel {
                 tear_per_m: (1500.0, 0.3),
                 plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.5,
+                // A baby carrot's hard, wet skin: a tip more than 30° off
+                // the normal skids (TA's tines meet its crest at 38°).
+                dig_in_angle: 30f64.to_radians(),
             },
             FoodKind::Cantaloupe => FoodModel {
                 kind,
@@ -566,6 +582,7 @@ impl FoodModel {
                 tear_per_m: (200.0, 0.3),
                 plate_friction: (0.6, 0.0),
                 cut_fraction_of_width: 0.4,
+                dig_in_angle: SOFT_DIG_IN,
             },
             FoodKind::Honeydew | FoodKind::Kiwi | FoodKind::Celery => {
                 unreachable!("derived kinds return above")
@@ -618,6 +635,7 @@ impl FoodModel {
             tear_per_m: pos(self.tear_per_m.0, self.tear_per_m.1),
             plate_friction: pos(self.plate_friction.0, self.plate_friction.1),
             cut_limit: self.cut_fraction_of_width * shape.half_extents()[1],
+            dig_in_angle: self.dig_in_angle,
             colour: self.kind.colour(),
         }
     }

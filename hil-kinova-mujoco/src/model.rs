@@ -45,6 +45,12 @@ pub struct SceneIds {
     pub arm_dof: [usize; 6],
     /// qpos address of fork pitch and roll.
     pub fork_qpos: [usize; 2],
+    /// Joint ids of fork pitch and roll.
+    pub fork_joint: [usize; 2],
+    /// Dof address of fork pitch and roll.
+    pub fork_dof: [usize; 2],
+    /// The fork motors (position servos `act_fork_pitch`, `act_fork_roll`).
+    pub fork_actuator: [usize; 2],
     /// Body of the fork (tines).
     pub fork_body: usize,
     /// Site at the wrist force/torque sensor (fork base frame).
@@ -123,6 +129,7 @@ fn id(model: &MjModel, origin: &str, kind: MjtObjBase, name: &str) -> Result<usi
                 MjtObjBase::mjOBJ_SITE => "site",
                 MjtObjBase::mjOBJ_GEOM => "geom",
                 MjtObjBase::mjOBJ_SENSOR => "sensor",
+                MjtObjBase::mjOBJ_ACTUATOR => "actuator",
                 _ => "element",
             },
             name: name.to_string(),
@@ -143,6 +150,11 @@ fn resolve(model: &MjModel, origin: &str) -> Result<SceneIds, KinovaError> {
     let pitch = id(model, origin, mjOBJ_JOINT, "fork_pitch")?;
     let roll = id(model, origin, mjOBJ_JOINT, "fork_roll")?;
     let fork_qpos = [qposadr[pitch] as usize, qposadr[roll] as usize];
+    let fork_dof = [dofadr[pitch] as usize, dofadr[roll] as usize];
+    let fork_actuator = [
+        id(model, origin, mjOBJ_ACTUATOR, "act_fork_pitch")?,
+        id(model, origin, mjOBJ_ACTUATOR, "act_fork_roll")?,
+    ];
     let mut tine_sites = [0; N_TINES];
     for (i, s) in tine_sites.iter_mut().enumerate() {
         *s = id(model, origin, mjOBJ_SITE, &format!("tine_tip_{i}"))?;
@@ -178,6 +190,9 @@ fn resolve(model: &MjModel, origin: &str) -> Result<SceneIds, KinovaError> {
         arm_qpos,
         arm_dof,
         fork_qpos,
+        fork_joint: [pitch, roll],
+        fork_dof,
+        fork_actuator,
         fork_body: id(model, origin, mjOBJ_BODY, "forkroll")?,
         wrist_site: id(model, origin, mjOBJ_SITE, "wrist_ft")?,
         tip_site: id(model, origin, mjOBJ_SITE, "fork_tip")?,

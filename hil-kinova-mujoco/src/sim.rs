@@ -8,7 +8,8 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use serde::Serialize;
 
 use crate::controller::{
-    Action, Kinematics, PoseTarget, RollBy, fork_base_orientation, min_jerk, tine_direction,
+    Action, Kinematics, PoseTarget, RollBy, approach_direction, fork_base_orientation, min_jerk,
+    tine_direction,
 };
 use crate::error::KinovaError;
 use crate::food::{FoodKind, FoodProps, Shape};
@@ -187,6 +188,8 @@ pub struct Simulator {
     free_dt: f64,
     hold: f64,
     roll_by: RollBy,
+    /// The fork motors as loaded (the 2-DoF fork's own servos).
+    fork_servo: ForkServo,
     /// Contact bits of every geom as loaded, to restore parked bodies.
     contacts0: Vec<(i32, i32)>,
     timing: Timing,
@@ -237,7 +240,9 @@ impl Simulator {
             .zip(m.geom_conaffinity())
             .map(|(&t, &a)| (t, a))
             .collect();
+        let fork_servo = ForkServo::of(data.model(), &ids);
         Ok(Self {
+            fork_servo,
             data,
             ids,
             kin,
@@ -293,6 +298,13 @@ impl Simulator {
     /// fork's γ joint).
     pub fn set_roll_by(&mut self, roll_by: RollBy) {
         self.roll_by = roll_by;
+        let servo = match roll_by {
+            RollBy::ForkGamma => self.fork_servo,
+            RollBy::ArmYaw => ForkServo::RIGID,
+        };
+        // SAFETY: only servo parameters of existing elements change (see
+        // ForkServo::apply); no count, address or array size.
+        servo.apply(unsafe { self.data.model_mut() }, &self.ids);
     }
 
     /// What turns the tine row by an action's roll.
@@ -672,9 +684,10 @@ impl Simulator {
         let fork = [beta, gamma];
         let base = fork_base_orientation(wrap_half_pi(handle_yaw));
         let u = tine_direction(&base, beta, gamma);
+        let dir = approach_direction(action, &u);
         let c = Vector3::from(perceived.centre);
         let entry = c + Vector3::new(0.0, 0.0, perceived.half_height);
-        let pre = entry - PRE_OFFSET * u;
+        let pre = entry - PRE_OFFSET * dir;
         let q_pre = self
             .kin
             .solve(&self.home, fork, &PoseTarget { tip: pre, base }, "pre-pose")?;
@@ -707,7 +720,9 @@ impl Simulator {
             k("pre_pose", &mut self.data);
         }
 
-        // Approach and penetrate along the tines.
+        // Approach and penetrate along the action's move-in direction
+        // (vertical for VS and TV, tilted for TA); the force threshold
+        // reads the wrist force along the tines.
         let mut q = q_pre;
         let mut travel = 0.0;
         let approach = PRE_OFFSET - 0.005;
@@ -719,7 +734,7 @@ impl Simulator {
             travel += v * self.dt;
             if step_i % 2 == 0 {
                 let target = PoseTarget {
-                    tip: pre + travel * u,
+                    tip: pre + travel * dir,
                     base,
                 };
                 q = self.kin.dls_step(&q, fork, &target, 0.05).0;
@@ -752,7 +767,7 @@ impl Simulator {
         // Lift straight up on a minimum-jerk profile (a real arm's
         // trajectory generator ramps up and down; an instant 10 cm/s start
         // jerks the item off the tines), then hold.
-        let tip0 = pre + travel * u;
+        let tip0 = pre + travel * dir;
         let n_lift = (LIFT_TIME / self.dt).round() as usize;
         for i in 1..=n_lift {
             if i % 2 == 0 || i == n_lift {
@@ -827,6 +842,63 @@ impl Simulator {
                 time: self.data.time(),
                 phase,
             })
+        }
+    }
+}
+
+/// The fork's two position servos (pitch β, roll γ): gains, torque limit
+/// and the reflected inertia of their gears.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ForkServo {
+    /// Stiffness (N·m/rad).
+    kp: f64,
+    /// Damping (N·m·s/rad).
+    kv: f64,
+    /// Largest torque (N·m).
+    torque: f64,
+    /// Armature (kg·m²).
+    armature: f64,
+}
+
+impl ForkServo {
+    /// A fork without joints, as in the published data set (Feng et al.
+    /// 2019: a fork with a force/torque sensor fixed to the arm): both
+    /// joints held by servos stiff and strong enough that a 25 N push on
+    /// the tines (about 3.5 N·m about the pitch axis) turns them by less
+    /// than a degree. The armature keeps the stiff servo stable at the 4 ms
+    /// step (`sqrt(kp / armature)·dt` ≈ 0.6).
+    const RIGID: ForkServo = ForkServo {
+        kp: 300.0,
+        kv: 3.0,
+        torque: 40.0,
+        armature: 0.01,
+    };
+
+    /// The servos of `model`'s fork (the first of the two; the MJCF gives
+    /// both the same).
+    fn of(model: &MjModel, ids: &SceneIds) -> Self {
+        let a = ids.fork_actuator[0];
+        ForkServo {
+            kp: model.actuator_gainprm()[a][0],
+            kv: -model.actuator_biasprm()[a][2],
+            torque: model.actuator_forcerange()[a][1],
+            armature: model.dof_armature()[ids.fork_dof[0]],
+        }
+    }
+
+    fn apply(&self, model: &mut MjModel, ids: &SceneIds) {
+        for i in 0..2 {
+            let a = ids.fork_actuator[i];
+            // SAFETY: only parameter values of existing actuators, joints and
+            // dofs change; no count, address or array size of the model.
+            unsafe {
+                model.actuator_gainprm_mut()[a][0] = self.kp;
+                model.actuator_biasprm_mut()[a][1] = -self.kp;
+                model.actuator_biasprm_mut()[a][2] = -self.kv;
+                model.actuator_forcerange_mut()[a] = [-self.torque, self.torque];
+                model.jnt_actfrcrange_mut()[ids.fork_joint[i]] = [-self.torque, self.torque];
+                model.dof_armature_mut()[ids.fork_dof[i]] = self.armature;
+            }
         }
     }
 }

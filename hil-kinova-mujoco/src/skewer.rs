@@ -6,8 +6,9 @@
 //! model turns the relative pose of each tine and each item into equal and
 //! opposite forces on the fork and the item (`xfrc_applied`). Per tine:
 //!
-//! 1. **Free** → **Indenting** when its tip enters an item at less than 45°
-//!    from the surface normal (a tip meeting a rounded flank more obliquely
+//! 1. **Free** → **Indenting** when its tip enters an item at less than the
+//!    item's dig-in angle from the surface normal (45° for soft flesh, 30°
+//!    for a carrot's hard skin; a tip meeting the surface more obliquely
 //!    skids past it: no force, it stays free). The surface
 //!    pushes back with `k·d` along the tine (`d` = travel past the entry
 //!    point) and holds the tip laterally by friction (at most half the
@@ -257,7 +258,7 @@ impl SkewerModel {
                         // A tip meeting the surface obliquely (a carrot's
                         // flank) skids along it instead of digging in.
                         let n = f.rot * props.shape.surface_normal(&local);
-                        if (-u).dot(&n) < GLANCE_COS {
+                        if (-u).dot(&n) < props.dig_in_angle.cos() {
                             continue;
                         }
                         return TineState::Indenting {
@@ -428,10 +429,6 @@ impl SkewerModel {
     }
 }
 
-/// Cosine of the largest angle between a tine and the surface normal at
-/// which the tip digs in (45°); steeper contacts glance off.
-const GLANCE_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
-
 /// Largest downward force passed to an item pressed against the plate (N).
 const PRESS_CAP: f64 = 1.0;
 /// Per-tine coupling stiffness of a pierced tine, in units of m/REF_DT².
@@ -539,6 +536,38 @@ mod tests {
         };
         assert!(matches!(state(0.0), TineState::Indenting { .. }));
         assert_eq!(state(0.85 * r), TineState::Free);
+    }
+
+    #[test]
+    fn a_tip_skids_on_a_carrots_skin_at_an_angle_that_digs_into_melon() {
+        // TA's tines meet a flat top about 38° off the normal: past the
+        // carrot's 30° dig-in angle, within the melon's 45°.
+        let lean = 38f64.to_radians();
+        let dir = Vector3::new(lean.sin(), 0.0, -lean.cos());
+        for (kind, digs) in [(FoodKind::Carrot, false), (FoodKind::Cantaloupe, true)] {
+            let props = item(kind);
+            let top = props.shape.half_extents()[2];
+            let foods = [FoodView {
+                pos: Vector3::zeros(),
+                rot: Matrix3::identity(),
+                com: Vector3::zeros(),
+                props: Some(&props),
+            }];
+            let mut m = SkewerModel::new(0);
+            let t = TinePose {
+                tip: Vector3::new(0.0, 0.0, top - 0.0002),
+                dir,
+            };
+            m.step(
+                REF_DT,
+                &[t; N_TINES],
+                Vector3::new(0.0, 0.0, 0.1),
+                &foods,
+                &mut [Wrench::default()],
+            );
+            let dug = matches!(m.tines()[0], TineState::Indenting { .. });
+            assert_eq!(dug, digs, "{kind:?}: {:?}", m.tines()[0]);
+        }
     }
 
     #[test]

@@ -59,10 +59,12 @@ pub struct CalibrateArgs {
     /// counts, heights) to this file as JSON lines.
     #[arg(long)]
     pub attempts: Option<PathBuf>,
-    /// What turns the tine row by an action's roll: `fork_gamma` (the
-    /// fork's γ joint about the pitched handle) or `arm_yaw` (the arm turns
-    /// a rigid fork about the vertical, as in the published data set).
-    #[arg(long, default_value = "fork_gamma")]
+    /// The tool: `arm_yaw` (default: a rigid fork that the arm turns about
+    /// the vertical, as in the published data set the rates come from, so
+    /// the comparison is like with like) or `fork_gamma` (the study robot's
+    /// 2-DoF fork, whose γ joint turns the tine row about the pitched
+    /// handle and whose servos yield: the same foods on another tool).
+    #[arg(long, default_value = "arm_yaw")]
     pub roll_by: String,
     /// Print a JSON object instead of a table.
     #[arg(long)]
@@ -234,7 +236,15 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         "Simulated success rate (published rate) per action; {} trials each ({} per setting).",
         opts.trials, per_setting
     );
-    println!("Simulated attempts with synthetic food properties; published: Feng et al. 2019.");
+    println!(
+        "Simulated attempts with synthetic food properties, tool `{}`{}; published: Feng et al. 2019.",
+        report.roll_by.name(),
+        match report.roll_by {
+            RollBy::ArmYaw => " (the published data set's rigid fork)",
+            RollBy::ForkGamma =>
+                " (the study's 2-DoF fork: not the tool the published rates measured)",
+        }
+    );
     let header = || {
         print!("{:<22}", "food");
         for a in hil_envs::feeding::action_space().names() {

@@ -5,7 +5,7 @@
 
 use hil_kinova_mujoco::{
     ACTIONS, Action, FoodKind, FoodModel, KinovaError, PUBLISHED_HOLD, PerceivedTarget, Placement,
-    Simulator,
+    RollBy, Simulator, StopReason,
 };
 use rand::SeedableRng;
 
@@ -48,9 +48,12 @@ fn skewered_items_stay_on_the_fork_through_the_5_s_hold() {
     let mut lifted = 0;
     for (kind, name) in cases {
         let action = ACTIONS.iter().find(|a| a.name == name).unwrap();
-        for seed in 0..4 {
+        for seed in 0..6 {
             let r = attempt(&mut sim, kind, action, seed);
-            if r.lifted_height < 0.03 || r.tines.max_pierced < 2 {
+            // Items lifted on at least two tines, none torn out: an item
+            // left hanging on the one tine that did not tear is the tear
+            // model's outcome, not the hold's.
+            if r.lifted_height < 0.03 || r.tines.max_pierced < 2 || r.tines.torn > 0 {
                 continue;
             }
             lifted += 1;
@@ -67,7 +70,7 @@ fn skewered_items_stay_on_the_fork_through_the_5_s_hold() {
             assert!(r.sim_time > PUBLISHED_HOLD, "{r:?}");
         }
     }
-    assert!(lifted >= 8, "only {lifted} of 16 attempts lifted an item");
+    assert!(lifted >= 8, "only {lifted} of 24 attempts lifted an item");
 }
 
 #[test]
@@ -106,6 +109,35 @@ fn each_action_rolls_by_the_forks_gamma_while_the_arm_holds_the_handle() {
             r.reached_roll
         );
     }
+}
+
+#[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
+fn the_data_sets_rigid_fork_reaches_tvs_force_where_the_2_dof_forks_servos_yield() {
+    // TV on a banana slice: the tines go through and press on the plate.
+    // The published data set's fork (no joints) stops at TV's 20 N; the
+    // study fork's pitch servo (0.93 N·m) yields under the off-axis push,
+    // the tines swing and drag the slice across the plate.
+    let tv0 = ACTIONS.iter().find(|a| a.name == "TV0").unwrap();
+    let mut run = |roll_by: RollBy| {
+        let mut sim = Simulator::new().unwrap();
+        sim.set_roll_by(roll_by);
+        (0..3)
+            .map(|seed| attempt(&mut sim, FoodKind::Banana, tv0, seed))
+            .collect::<Vec<_>>()
+    };
+    for r in run(RollBy::ArmYaw) {
+        assert_eq!(r.stop, StopReason::Force, "{r:?}");
+        assert!(r.push_shift < 0.003, "rigid fork dragged the slice: {r:?}");
+        assert!(r.reached_gamma.abs() < 0.01, "{r:?}");
+    }
+    let yielding = run(RollBy::ForkGamma);
+    assert!(
+        yielding
+            .iter()
+            .any(|r| r.stop == StopReason::Depth && r.peak_force < tv0.max_force),
+        "{yielding:?}"
+    );
 }
 
 #[test]

@@ -531,6 +531,9 @@ impl FoodModel {
                 FoodKind::Celery => FoodModel {
                     kind,
                     puncture_force: (3.5, 0.15),
+                    // Its ridged, fibrous face catches a tip that a
+                    // carrot's smooth skin lets skid (published TA90 0.8).
+                    dig_in_angle: SOFT_DIG_IN,
                     ..base
                 },
                 _ => base,

@@ -119,7 +119,7 @@ fn the_data_sets_rigid_fork_reaches_tvs_force_where_the_2_dof_forks_servos_yield
     // study fork's pitch servo (0.93 N·m) yields under the off-axis push,
     // the tines swing and drag the slice across the plate.
     let tv0 = ACTIONS.iter().find(|a| a.name == "TV0").unwrap();
-    let mut run = |roll_by: RollBy| {
+    let run = |roll_by: RollBy| {
         let mut sim = Simulator::new().unwrap();
         sim.set_roll_by(roll_by);
         (0..3)

@@ -188,8 +188,8 @@ pub struct Simulator {
     free_dt: f64,
     hold: f64,
     roll_by: RollBy,
-    /// The fork motors as loaded (the 2-DoF fork's own servos).
-    fork_servo: ForkServo,
+    /// The fork motors (pitch, roll) as loaded: the 2-DoF fork's own servos.
+    fork_servo: [ForkServo; 2],
     /// Contact bits of every geom as loaded, to restore parked bodies.
     contacts0: Vec<(i32, i32)>,
     timing: Timing,
@@ -240,7 +240,7 @@ impl Simulator {
             .zip(m.geom_conaffinity())
             .map(|(&t, &a)| (t, a))
             .collect();
-        let fork_servo = ForkServo::of(data.model(), &ids);
+        let fork_servo = [0, 1].map(|i| ForkServo::of(data.model(), &ids, i));
         Ok(Self {
             fork_servo,
             data,
@@ -298,13 +298,15 @@ impl Simulator {
     /// fork's γ joint).
     pub fn set_roll_by(&mut self, roll_by: RollBy) {
         self.roll_by = roll_by;
-        let servo = match roll_by {
+        let servos = match roll_by {
             RollBy::ForkGamma => self.fork_servo,
-            RollBy::ArmYaw => ForkServo::RIGID,
+            RollBy::ArmYaw => [ForkServo::RIGID; 2],
         };
-        // SAFETY: only servo parameters of existing elements change (see
-        // ForkServo::apply); no count, address or array size.
-        servo.apply(unsafe { self.data.model_mut() }, &self.ids);
+        for (i, servo) in servos.iter().enumerate() {
+            // SAFETY: only servo parameters of existing elements change
+            // (see ForkServo::apply); no count, address or array size.
+            servo.apply(unsafe { self.data.model_mut() }, &self.ids, i);
+        }
     }
 
     /// What turns the tine row by an action's roll.
@@ -874,31 +876,29 @@ impl ForkServo {
         armature: 0.01,
     };
 
-    /// The servos of `model`'s fork (the first of the two; the MJCF gives
-    /// both the same).
-    fn of(model: &MjModel, ids: &SceneIds) -> Self {
-        let a = ids.fork_actuator[0];
+    /// Fork servo `i` (0 pitch, 1 roll) of `model`.
+    fn of(model: &MjModel, ids: &SceneIds, i: usize) -> Self {
+        let a = ids.fork_actuator[i];
         ForkServo {
             kp: model.actuator_gainprm()[a][0],
             kv: -model.actuator_biasprm()[a][2],
             torque: model.actuator_forcerange()[a][1],
-            armature: model.dof_armature()[ids.fork_dof[0]],
+            armature: model.dof_armature()[ids.fork_dof[i]],
         }
     }
 
-    fn apply(&self, model: &mut MjModel, ids: &SceneIds) {
-        for i in 0..2 {
-            let a = ids.fork_actuator[i];
-            // SAFETY: only parameter values of existing actuators, joints and
-            // dofs change; no count, address or array size of the model.
-            unsafe {
-                model.actuator_gainprm_mut()[a][0] = self.kp;
-                model.actuator_biasprm_mut()[a][1] = -self.kp;
-                model.actuator_biasprm_mut()[a][2] = -self.kv;
-                model.actuator_forcerange_mut()[a] = [-self.torque, self.torque];
-                model.jnt_actfrcrange_mut()[ids.fork_joint[i]] = [-self.torque, self.torque];
-                model.dof_armature_mut()[ids.fork_dof[i]] = self.armature;
-            }
+    /// Makes fork servo `i` (0 pitch, 1 roll) of `model` this one.
+    fn apply(&self, model: &mut MjModel, ids: &SceneIds, i: usize) {
+        let a = ids.fork_actuator[i];
+        // SAFETY: only parameter values of existing actuators, joints and
+        // dofs change; no count, address or array size of the model.
+        unsafe {
+            model.actuator_gainprm_mut()[a][0] = self.kp;
+            model.actuator_biasprm_mut()[a][1] = -self.kp;
+            model.actuator_biasprm_mut()[a][2] = -self.kv;
+            model.actuator_forcerange_mut()[a] = [-self.torque, self.torque];
+            model.jnt_actfrcrange_mut()[ids.fork_joint[i]] = [-self.torque, self.torque];
+            model.dof_armature_mut()[ids.fork_dof[i]] = self.armature;
         }
     }
 }

@@ -475,15 +475,20 @@ mod tests {
         FoodModel::default_for(kind).sample(&mut rand_chacha::ChaCha8Rng::seed_from_u64(4))
     }
 
-    fn press(props: &FoodProps, depth: f64) -> (SkewerModel, Wrench) {
-        let mut m = SkewerModel::new(0);
-        let top = props.shape.half_extents()[2];
-        let foods = [FoodView {
+    /// An item with its frame at the world origin.
+    fn at_origin(props: &FoodProps) -> FoodView<'_> {
+        FoodView {
             pos: Vector3::zeros(),
             rot: Matrix3::identity(),
             com: Vector3::zeros(),
             props: Some(props),
-        }];
+        }
+    }
+
+    fn press(props: &FoodProps, depth: f64) -> (SkewerModel, Wrench) {
+        let mut m = SkewerModel::new(0);
+        let top = props.shape.half_extents()[2];
+        let foods = [at_origin(props)];
         let mut out = [Wrench::default()];
         let mut fork = Wrench::default();
         // Lower the tines in 0.1 mm steps from just above the surface.
@@ -509,12 +514,7 @@ mod tests {
     fn a_tine_glances_off_a_rounded_flank_but_digs_into_the_crest() {
         let carrot = item(FoodKind::Carrot);
         let r = carrot.shape.half_extents()[1];
-        let foods = [FoodView {
-            pos: Vector3::zeros(),
-            rot: Matrix3::identity(),
-            com: Vector3::zeros(),
-            props: Some(&carrot),
-        }];
+        let foods = [at_origin(&carrot)];
         let mut out = [Wrench::default()];
         // Straight down, just inside the surface: at the crest (y = 0) and on
         // the flank 0.85 r off the axis (about 58° from the normal).
@@ -547,12 +547,7 @@ mod tests {
         for (kind, digs) in [(FoodKind::Carrot, false), (FoodKind::Cantaloupe, true)] {
             let props = item(kind);
             let top = props.shape.half_extents()[2];
-            let foods = [FoodView {
-                pos: Vector3::zeros(),
-                rot: Matrix3::identity(),
-                com: Vector3::zeros(),
-                props: Some(&props),
-            }];
+            let foods = [at_origin(&props)];
             let mut m = SkewerModel::new(0);
             let t = TinePose {
                 tip: Vector3::new(0.0, 0.0, top - 0.0002),

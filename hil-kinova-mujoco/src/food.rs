@@ -516,14 +516,18 @@ impl FoodModel {
             return match kind {
                 // Melon like cantaloupe: the same flesh.
                 FoodKind::Honeydew => FoodModel { kind, ..base },
-                // A kiwi slice is firmer than banana and its seeds and
-                // core grip a tine: more puncture force, grip and tear
-                // strength.
+                // A kiwi slice is firmer than banana and its core grips a
+                // tine along its axis (more puncture force and axial
+                // grip: vertical tines hold it, published VS/TV 0.5-0.57),
+                // but its wet, seedy flesh gives a tilted tine less
+                // friction and tears sideways sooner (TA 0.4, below
+                // banana's 0.57).
                 FoodKind::Kiwi => FoodModel {
                     kind,
                     puncture_force: (0.8, 0.3),
-                    grip_per_m: (1.0, 0.5),
-                    tear_per_m: (30.0, 0.3),
+                    grip_per_m: (2.5, 0.5),
+                    friction: (0.5, 0.3),
+                    tear_per_m: (12.0, 0.3),
                     ..base
                 },
                 // Celery's fibres part far more easily than a carrot's

@@ -76,8 +76,10 @@ pub struct KinovaFeedingConfig {
     /// published rule is 5 s.
     #[serde(default = "default_hold")]
     pub hold_s: f64,
-    /// What turns the tine row by an action's roll: `fork_gamma` (the
-    /// fork's γ joint, default) or `arm_yaw` (the arm turns a rigid fork).
+    /// The tool and what turns the tine row by an action's roll:
+    /// `fork_gamma` (default: the study's 2-DoF fork, its γ joint, its own
+    /// yielding servos) or `arm_yaw` (the published data set's rigid fork,
+    /// turned by the arm).
     #[serde(default)]
     pub roll_by: RollBy,
 }

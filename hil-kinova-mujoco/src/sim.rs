@@ -18,9 +18,10 @@ use crate::skewer::{FoodView, MAX_DT, REF_DT, SkewerModel, SkewerStats, TinePose
 
 /// Height of the plate's top surface above its body frame (m).
 const PLATE_TOP: f64 = 0.006;
-/// Approach starts this far back from the entry point along the tines (m).
+/// Approach starts this far back from the entry point along the move-in (m).
 const PRE_OFFSET: f64 = 0.04;
-/// Deepest travel past the perceived top surface (m): ADA's Gen3 value.
+/// Deepest travel past the perceived top surface, along the move-in (m):
+/// ADA's Gen3 value.
 const DEPTH_LIMIT: f64 = 0.035;
 /// Lift height (m), as ADA's two 0.025 m moves plus margin.
 const LIFT: f64 = 0.06;

@@ -110,16 +110,28 @@ impl PolicyState {
     /// Decides for `context` at `t` with its own forecast and query
     /// history, adding the query it asks (if any) to that history; returns
     /// the arm, or `n_arms` for "ask".
+    /// The policy's `decide` for `context` at `t` and item position `at`
+    /// (item index, items seen, attempt), with the workload forecast of
+    /// `model` from `wl0` given `history`.
+    fn decide_at(
+        &mut self,
+        context: &Context,
+        t: Timestep,
+        at: (usize, usize, u32),
+        model: Option<&dyn WorkloadModel>,
+        wl0: f64,
+        history: &QueryHistory,
+    ) -> Result<Decision> {
+        let forecast = WorkloadForecast::new(model, wl0, history, t);
+        let input = DecisionInput::new(context, t, forecast).at_item(at.0, at.1, at.2);
+        self.decide(&input)
+    }
+
     fn act(&mut self, context: &Context, t: Timestep, at: (usize, usize, u32)) -> Result<usize> {
+        // The policy's own forecast and history, borrowed without a copy.
         let history = std::mem::take(&mut self.history);
         let forecast = self.forecast.clone();
-        let input = DecisionInput::new(
-            context,
-            t,
-            WorkloadForecast::new(forecast.as_deref(), self.wl0, &history, t),
-        )
-        .at_item(at.0, at.1, at.2);
-        let decision = self.decide(&input);
+        let decision = self.decide_at(context, t, at, forecast.as_deref(), self.wl0, &history);
         self.history = history;
         Ok(match decision?.choice {
             Choice::Act { arm } => arm.0,
@@ -373,10 +385,8 @@ impl PyPolicyHandle {
                 let model = model.or_else(|| state.forecast.clone());
                 let wl0 = wl0.unwrap_or(state.wl0);
                 let history = given.unwrap_or_else(|| state.history.clone());
-                let forecast = WorkloadForecast::new(model.as_deref(), wl0, &history, t);
-                let input =
-                    DecisionInput::new(&x, t, forecast).at_item(item_index, items_seen, attempt);
-                state.decide(&input)
+                let at = (item_index, items_seen, attempt);
+                state.decide_at(&x, t, at, model.as_deref(), wl0, &history)
             })
             .py_err()?;
         to_py(py, &decision, "decision")

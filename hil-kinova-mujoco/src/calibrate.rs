@@ -407,17 +407,33 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Trials, discarded trials and successes among `records`: an attempt in
-/// which fewer than [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines
-/// touched the item is discarded, as in the published data set, and counts
-/// neither way.
-fn count(records: &[&&AttemptRecord]) -> (usize, usize, usize) {
+/// Trials, discarded trials and successes among some attempts, and the
+/// success rate over those that counted with its binomial SE.
+struct Tally {
+    trials: usize,
+    discarded: usize,
+    successes: usize,
+    rate: f64,
+    se: f64,
+}
+
+/// Tallies `records`: an attempt in which fewer than
+/// [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines touched the item
+/// is discarded, as in the published data set, and counts neither way.
+fn count(records: &[&&AttemptRecord]) -> Tally {
     let discarded = records.iter().filter(|r| !r.report.counted).count();
     let successes = records
         .iter()
         .filter(|r| r.report.counted && r.report.success)
         .count();
-    (records.len(), discarded, successes)
+    let counted = records.len() - discarded;
+    Tally {
+        trials: records.len(),
+        discarded,
+        successes,
+        rate: successes as f64 / counted.max(1) as f64,
+        se: binomial_se(successes, counted),
+    }
 }
 
 /// Groups attempt records into rows per (food, action), in job order.
@@ -435,21 +451,19 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                 .map(|&setting| {
                     let here: Vec<&&AttemptRecord> =
                         cell.iter().filter(|r| r.setting == setting).collect();
-                    let (trials, discarded, successes) = count(&here);
-                    let counted = trials - discarded;
+                    let t = count(&here);
                     SettingCell {
                         setting,
-                        trials,
-                        discarded,
-                        successes,
-                        rate: successes as f64 / counted.max(1) as f64,
-                        se: binomial_se(successes, counted),
+                        trials: t.trials,
+                        discarded: t.discarded,
+                        successes: t.successes,
+                        rate: t.rate,
+                        se: t.se,
                         published: Some(food.published_rates_in(setting)[a]),
                     }
                 })
                 .collect();
-            let (trials, discarded, successes) = count(&cell.iter().collect::<Vec<_>>());
-            let counted = trials - discarded;
+            let t = count(&cell.iter().collect::<Vec<_>>());
             // With all three settings equally represented the published
             // `all` row applies; otherwise the trial-weighted mean of the
             // settings run.
@@ -463,17 +477,17 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                         .iter()
                         .map(|c| food.published_rates_in(c.setting)[a] * c.trials as f64)
                         .sum::<f64>()
-                        / trials.max(1) as f64,
+                        / t.trials.max(1) as f64,
                 )
             };
             rows.push(CalibrationRow {
                 food: food.name().into(),
                 action: action.name.into(),
-                trials,
-                discarded,
-                successes,
-                rate: successes as f64 / counted.max(1) as f64,
-                se: binomial_se(successes, counted),
+                trials: t.trials,
+                discarded: t.discarded,
+                successes: t.successes,
+                rate: t.rate,
+                se: t.se,
                 published,
                 by_setting,
             });

@@ -155,6 +155,14 @@ pub struct CalibrationReport {
     /// ones on the trials counted here). The floor `mean_abs_error` is to
     /// be read against.
     pub noise_floor: f64,
+    /// The acceptance this table is read against.
+    pub target: CalibrationTarget,
+    /// Whether this run meets [`target`](Self::target).
+    pub meets_target: bool,
+    /// The probability that a perfect simulator (as for `noise_floor`)
+    /// meets [`target`](Self::target) in one run with these trial counts:
+    /// how often a run *can* meet it, whatever the model.
+    pub perfect_simulator_meets_target: f64,
     /// How long an item had to stay on the lifted fork (s).
     pub hold_s: f64,
     /// What turned the tine row by the actions' roll.
@@ -309,8 +317,18 @@ pub fn calibrate_with(
             .map(expected_abs_error_of_a_perfect_simulator)
             .collect(),
     );
+    let mean_abs_error = mean(
+        rows.iter()
+            .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
+            .collect(),
+    );
+    let target = CalibrationTarget::ACCEPTANCE;
+    let compared: Vec<&CalibrationRow> = rows.iter().filter(|r| r.published.is_some()).collect();
     Ok(CalibrationReport {
         noise_floor,
+        target,
+        meets_target: target.is_met(mean_abs_error, max_abs_error),
+        perfect_simulator_meets_target: target.chance_a_perfect_simulator_meets(&compared),
         max_abs_error,
         hold_s,
         roll_by: opts.roll_by,
@@ -319,11 +337,7 @@ pub fn calibrate_with(
             * cpu.as_secs_f64()
             * (in_step.as_secs_f64() / busy.as_secs_f64().max(1e-9))
             / steps.max(1) as f64,
-        mean_abs_error: mean(
-            rows.iter()
-                .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
-                .collect(),
-        ),
+        mean_abs_error,
         mean_abs_error_by_setting: mean(
             rows.iter()
                 .flat_map(|r| &r.by_setting)
@@ -350,6 +364,16 @@ pub const PUBLISHED_TRIALS_PER_SETTING: usize = 10;
 /// binomials over the trials counted per setting; both distributions are
 /// enumerated exactly.
 pub fn expected_abs_error_of_a_perfect_simulator(row: &CalibrationRow) -> f64 {
+    perfect_simulator_errors(row)
+        .iter()
+        .map(|(e, p)| e * p)
+        .sum()
+}
+
+/// The distribution of |simulated − published| of `row` for a perfect
+/// simulator (see [`expected_abs_error_of_a_perfect_simulator`]): every
+/// (published count, simulated count) pair as (|error|, probability).
+fn perfect_simulator_errors(row: &CalibrationRow) -> Vec<(f64, f64)> {
     let sum_of = |trials: &dyn Fn(&SettingCell) -> usize| -> Vec<f64> {
         row.by_setting.iter().fold(vec![1.0], |dist, c| {
             convolve(&dist, &binomial_pmf(trials(c), c.published.unwrap_or(0.0)))
@@ -359,16 +383,99 @@ pub fn expected_abs_error_of_a_perfect_simulator(row: &CalibrationRow) -> f64 {
     let simulated = sum_of(&|c| c.trials - c.discarded);
     let (np, ns) = (published.len() - 1, simulated.len() - 1);
     if np == 0 || ns == 0 {
-        return 0.0;
+        return vec![(0.0, 1.0)];
     }
-    let mut e = 0.0;
+    let mut out = Vec::with_capacity(published.len() * simulated.len());
     for (i, pi) in published.iter().enumerate() {
         for (j, pj) in simulated.iter().enumerate() {
-            e += pi * pj * (i as f64 / np as f64 - j as f64 / ns as f64).abs();
+            out.push(((i as f64 / np as f64 - j as f64 / ns as f64).abs(), pi * pj));
         }
     }
-    e
+    out
 }
+
+/// The acceptance a calibration run is read against: the mean
+/// |simulated − published| over the overall cells and the largest one.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CalibrationTarget {
+    /// Largest acceptable mean |simulated − published| over the cells.
+    pub mean_abs_error: f64,
+    /// Largest acceptable |simulated − published| of any one cell.
+    pub worst_cell: f64,
+}
+
+impl CalibrationTarget {
+    /// The project's acceptance for the Kinova simulation: mean ≤ 0.06
+    /// and no cell off by more than 0.15 (at ≥ 60 trials per cell).
+    pub const ACCEPTANCE: CalibrationTarget = CalibrationTarget {
+        mean_abs_error: 0.06,
+        worst_cell: 0.15,
+    };
+
+    /// Whether a run with this mean and largest error meets the target
+    /// (to within rounding: an error of exactly 0.15 is not above 0.15).
+    pub fn is_met(&self, mean_abs_error: f64, max_abs_error: f64) -> bool {
+        mean_abs_error <= self.mean_abs_error + TARGET_TOLERANCE
+            && max_abs_error <= self.worst_cell + TARGET_TOLERANCE
+    }
+
+    /// The probability that one run of a perfect simulator over `rows`
+    /// (their settings and counted trials) meets the target: the cells'
+    /// errors are independent, so the chance that every cell is within
+    /// `worst_cell` *and* their sum within `mean_abs_error · rows` is
+    /// their distributions (restricted to `worst_cell`) convolved, with
+    /// errors binned to 1/[`TARGET_GRID`] (exact when the published and
+    /// simulated trials per cell both divide it: 30 against 60, 90 or 120).
+    ///
+    /// ```
+    /// use hil_kinova_mujoco::{CalibrationOptions, CalibrationTarget, calibrate_with};
+    /// use hil_kinova_mujoco::{FoodKind, Setting};
+    ///
+    /// let opts = CalibrationOptions {
+    ///     foods: vec![FoodKind::Banana],
+    ///     settings: vec![Setting::Isolated],
+    ///     trials: 1,
+    ///     ..CalibrationOptions::default()
+    /// };
+    /// let report = calibrate_with(&opts, &|_, _| {}, &mut |_| {})?;
+    /// let rows: Vec<_> = report.rows.iter().collect();
+    /// let p = CalibrationTarget::ACCEPTANCE.chance_a_perfect_simulator_meets(&rows);
+    /// // One trial per cell against 10 published ones: rarely within target.
+    /// assert!(p > 0.0 && p < 0.2, "{p}");
+    /// assert_eq!(p, report.perfect_simulator_meets_target);
+    /// # Ok::<(), hil_core::HilError>(())
+    /// ```
+    pub fn chance_a_perfect_simulator_meets(&self, rows: &[&CalibrationRow]) -> f64 {
+        let bin = |e: f64| (e * TARGET_GRID).round() as usize;
+        let worst = bin(self.worst_cell);
+        let budget = bin(self.mean_abs_error * rows.len() as f64);
+        // dist[s]: probability that the cells so far are each within
+        // `worst` and sum to s bins (sums beyond the budget fail).
+        let mut dist = vec![0.0; budget + 1];
+        dist[0] = 1.0;
+        for row in rows {
+            let mut cell = vec![0.0; worst + 1];
+            for (e, p) in perfect_simulator_errors(row) {
+                if let Some(c) = cell.get_mut(bin(e)) {
+                    *c += p;
+                }
+            }
+            let mut next = vec![0.0; budget + 1];
+            for (s, ps) in dist.iter().enumerate().filter(|(_, p)| **p > 0.0) {
+                for (b, pb) in cell.iter().enumerate().take(budget + 1 - s) {
+                    next[s + b] += ps * pb;
+                }
+            }
+            dist = next;
+        }
+        dist.iter().sum()
+    }
+}
+
+/// Bins per unit of error in [`CalibrationTarget::chance_a_perfect_simulator_meets`].
+pub const TARGET_GRID: f64 = 3600.0;
+/// Rounding allowance when comparing an error with a target.
+const TARGET_TOLERANCE: f64 = 1e-9;
 
 /// Probabilities of 0..=n successes in n trials at rate p.
 fn binomial_pmf(n: usize, p: f64) -> Vec<f64> {
@@ -536,26 +643,7 @@ mod tests {
 
     #[test]
     fn a_perfect_simulator_still_differs_by_the_sampling_noise() {
-        let cell = |published: f64, trials: usize| SettingCell {
-            setting: Setting::Isolated,
-            trials,
-            discarded: 0,
-            successes: 0,
-            rate: 0.0,
-            se: 0.0,
-            published: Some(published),
-        };
-        let row = |published: f64, trials: usize| CalibrationRow {
-            food: "banana".into(),
-            action: "VS0".into(),
-            trials,
-            discarded: 0,
-            successes: 0,
-            rate: 0.0,
-            se: 0.0,
-            published: Some(published),
-            by_setting: vec![cell(published, trials)],
-        };
+        let row = one_setting_row;
         // Certain outcomes leave no noise.
         assert_eq!(
             expected_abs_error_of_a_perfect_simulator(&row(1.0, 20)),
@@ -578,6 +666,81 @@ mod tests {
         // More simulated trials shrink it, but not below the published noise.
         let more = expected_abs_error_of_a_perfect_simulator(&row(0.5, 1000));
         assert!(more < e && more > 0.1, "{more}");
+    }
+
+    fn one_setting_row(published: f64, trials: usize) -> CalibrationRow {
+        CalibrationRow {
+            food: "banana".into(),
+            action: "VS0".into(),
+            trials,
+            discarded: 0,
+            successes: 0,
+            rate: 0.0,
+            se: 0.0,
+            published: Some(published),
+            by_setting: vec![SettingCell {
+                setting: Setting::Isolated,
+                trials,
+                discarded: 0,
+                successes: 0,
+                rate: 0.0,
+                se: 0.0,
+                published: Some(published),
+            }],
+        }
+    }
+
+    #[test]
+    fn a_perfect_simulators_chance_of_meeting_the_target_is_the_joint_probability() {
+        let target = CalibrationTarget {
+            mean_abs_error: 0.1,
+            worst_cell: 0.15,
+        };
+        // Certain outcomes always meet it.
+        let certain = [one_setting_row(1.0, 20), one_setting_row(0.0, 20)];
+        let p = target.chance_a_perfect_simulator_meets(&certain.iter().collect::<Vec<_>>());
+        assert!((p - 1.0).abs() < 1e-12, "{p}");
+        // Two noisy cells (10 published, 20 simulated trials; errors are
+        // multiples of 1/20): both within 0.15 and together within 0.2,
+        // by direct enumeration of the pairs of errors.
+        let rows = [one_setting_row(0.5, 20), one_setting_row(0.3, 20)];
+        let (a, b) = (
+            perfect_simulator_errors(&rows[0]),
+            perfect_simulator_errors(&rows[1]),
+        );
+        let mut exact = 0.0;
+        for (ea, pa) in &a {
+            for (eb, pb) in &b {
+                if *ea <= 0.15 + 1e-9 && *eb <= 0.15 + 1e-9 && ea + eb <= 0.2 + 1e-9 {
+                    exact += pa * pb;
+                }
+            }
+        }
+        let p = target.chance_a_perfect_simulator_meets(&rows.iter().collect::<Vec<_>>());
+        assert!((p - exact).abs() < 1e-12, "{p} vs {exact}");
+        // Both constraints bind: neither alone gives the joint chance.
+        let cells_only: f64 = [&a, &b]
+            .iter()
+            .map(|d| {
+                d.iter()
+                    .filter(|(e, _)| *e <= 0.15 + 1e-9)
+                    .map(|(_, p)| p)
+                    .sum::<f64>()
+            })
+            .product();
+        assert!(
+            exact < cells_only - 0.01 && exact > 0.05,
+            "{exact} {cells_only}"
+        );
+    }
+
+    #[test]
+    fn a_target_allows_an_error_equal_to_its_bound_and_nothing_above() {
+        let t = CalibrationTarget::ACCEPTANCE;
+        assert!(t.is_met(0.06, 0.15));
+        assert!(t.is_met(0.03, 9.0 / 60.0));
+        assert!(!t.is_met(0.0601, 0.1));
+        assert!(!t.is_met(0.05, 0.1501));
     }
 
     #[test]

@@ -53,8 +53,8 @@ mod without_physics;
 
 #[cfg(feature = "physics")]
 pub use calibrate::{
-    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow,
-    PUBLISHED_TRIALS_PER_SETTING, SettingCell, calibrate, calibrate_with,
+    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow, CalibrationTarget,
+    PUBLISHED_TRIALS_PER_SETTING, SettingCell, TARGET_GRID, calibrate, calibrate_with,
     expected_abs_error_of_a_perfect_simulator,
 };
 #[cfg(feature = "physics")]

@@ -286,6 +286,18 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         report.noise_floor,
         hil_kinova_mujoco::PUBLISHED_TRIALS_PER_SETTING
     );
+    let t = report.target;
+    println!(
+        "target (mean <= {:.2}, no cell off by more than {:.2}): {}; a perfect simulator meets it in {:.0}% of runs with these trial counts",
+        t.mean_abs_error,
+        t.worst_cell,
+        if report.meets_target {
+            "met"
+        } else {
+            "not met"
+        },
+        100.0 * report.perfect_simulator_meets_target
+    );
     let discarded: usize = report.rows.iter().map(|r| r.discarded).sum();
     println!(
         "{discarded} of {} attempts discarded (fewer than {} tines touched the item, as in the published data set); rates are over the rest",

@@ -47,6 +47,16 @@ fn calibrate_prints_rates_beside_the_published_ones() {
             .all(|r| (0.0..=1.0).contains(&r["rate"].as_f64().unwrap()))
     );
     assert!(v["attempts_per_second"].as_f64().unwrap() > 0.0);
+    // The verdict against the acceptance, and how often a perfect
+    // simulator would meet it with 3 trials per cell (rarely).
+    assert_eq!(v["target"]["worst_cell"], 0.15);
+    let (mean, worst) = (
+        v["mean_abs_error"].as_f64().unwrap(),
+        v["max_abs_error"].as_f64().unwrap(),
+    );
+    assert_eq!(v["meets_target"], mean <= 0.06 && worst <= 0.15);
+    let chance = v["perfect_simulator_meets_target"].as_f64().unwrap();
+    assert!(chance > 0.0 && chance < 0.5, "{chance}");
 
     let out = hil(&["kinova", "calibrate", "--foods", "apple"]);
     assert!(!out.status.success());

@@ -307,23 +307,21 @@ pub fn calibrate_with(
     let rows = tabulate(opts, &records);
     let (in_step, busy) = timing;
     let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    let max_abs_error = rows
+    // The overall rows that have a published rate to compare with.
+    let compared: Vec<&CalibrationRow> = rows.iter().filter(|r| r.published.is_some()).collect();
+    let errors: Vec<f64> = compared
         .iter()
         .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
-        .fold(0.0, f64::max);
+        .collect();
+    let max_abs_error = errors.iter().copied().fold(0.0, f64::max);
+    let mean_abs_error = mean(errors);
     let noise_floor = mean(
-        rows.iter()
-            .filter(|r| r.published.is_some())
-            .map(expected_abs_error_of_a_perfect_simulator)
-            .collect(),
-    );
-    let mean_abs_error = mean(
-        rows.iter()
-            .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
+        compared
+            .iter()
+            .map(|r| expected_abs_error_of_a_perfect_simulator(r))
             .collect(),
     );
     let target = CalibrationTarget::ACCEPTANCE;
-    let compared: Vec<&CalibrationRow> = rows.iter().filter(|r| r.published.is_some()).collect();
     Ok(CalibrationReport {
         noise_floor,
         target,

@@ -666,25 +666,27 @@ mod tests {
         assert!(more < e && more > 0.1, "{more}");
     }
 
+    /// A row of one setting whose counts are the cell's.
     fn one_setting_row(published: f64, trials: usize) -> CalibrationRow {
-        CalibrationRow {
-            food: "banana".into(),
-            action: "VS0".into(),
+        let cell = SettingCell {
+            setting: Setting::Isolated,
             trials,
             discarded: 0,
             successes: 0,
             rate: 0.0,
             se: 0.0,
             published: Some(published),
-            by_setting: vec![SettingCell {
-                setting: Setting::Isolated,
-                trials,
-                discarded: 0,
-                successes: 0,
-                rate: 0.0,
-                se: 0.0,
-                published: Some(published),
-            }],
+        };
+        CalibrationRow {
+            food: "banana".into(),
+            action: "VS0".into(),
+            trials: cell.trials,
+            discarded: cell.discarded,
+            successes: cell.successes,
+            rate: cell.rate,
+            se: cell.se,
+            published: cell.published,
+            by_setting: vec![cell],
         }
     }
 

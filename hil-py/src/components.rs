@@ -107,9 +107,6 @@ impl PolicyState {
         learnt
     }
 
-    /// Decides for `context` at `t` with its own forecast and query
-    /// history, adding the query it asks (if any) to that history; returns
-    /// the arm, or `n_arms` for "ask".
     /// The policy's `decide` for `context` at `t` and item position `at`
     /// (item index, items seen, attempt), with the workload forecast of
     /// `model` from `wl0` given `history`.
@@ -127,6 +124,9 @@ impl PolicyState {
         self.decide(&input)
     }
 
+    /// Decides for `context` at `t` with its own forecast and query
+    /// history, adding the query it asks (if any) to that history; returns
+    /// the arm, or `n_arms` for "ask".
     fn act(&mut self, context: &Context, t: Timestep, at: (usize, usize, u32)) -> Result<usize> {
         // The policy's own forecast and history, borrowed without a copy.
         let history = std::mem::take(&mut self.history);

@@ -857,8 +857,10 @@ struct ForkServo {
     kp: f64,
     /// Damping (N·m·s/rad).
     kv: f64,
-    /// Largest torque (N·m).
-    torque: f64,
+    /// Torque range of the actuator (N·m).
+    torque: [f64; 2],
+    /// Torque range the joint accepts from its actuators (N·m).
+    joint_torque: [f64; 2],
     /// Armature (kg·m²).
     armature: f64,
 }
@@ -873,7 +875,8 @@ impl ForkServo {
     const RIGID: ForkServo = ForkServo {
         kp: 300.0,
         kv: 3.0,
-        torque: 40.0,
+        torque: [-40.0, 40.0],
+        joint_torque: [-40.0, 40.0],
         armature: 0.01,
     };
 
@@ -883,7 +886,8 @@ impl ForkServo {
         ForkServo {
             kp: model.actuator_gainprm()[a][0],
             kv: -model.actuator_biasprm()[a][2],
-            torque: model.actuator_forcerange()[a][1],
+            torque: model.actuator_forcerange()[a],
+            joint_torque: model.jnt_actfrcrange()[ids.fork_joint[i]],
             armature: model.dof_armature()[ids.fork_dof[i]],
         }
     }
@@ -897,8 +901,8 @@ impl ForkServo {
             model.actuator_gainprm_mut()[a][0] = self.kp;
             model.actuator_biasprm_mut()[a][1] = -self.kp;
             model.actuator_biasprm_mut()[a][2] = -self.kv;
-            model.actuator_forcerange_mut()[a] = [-self.torque, self.torque];
-            model.jnt_actfrcrange_mut()[ids.fork_joint[i]] = [-self.torque, self.torque];
+            model.actuator_forcerange_mut()[a] = self.torque;
+            model.jnt_actfrcrange_mut()[ids.fork_joint[i]] = self.joint_torque;
             model.dof_armature_mut()[ids.fork_dof[i]] = self.armature;
         }
     }

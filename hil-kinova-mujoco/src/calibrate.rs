@@ -34,6 +34,7 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
+use hil_core::metrics::Stat;
 use hil_core::{ArmId, Environment, HilError, Result};
 use serde::Serialize;
 
@@ -41,6 +42,7 @@ use crate::controller::{ACTIONS, RollBy};
 use crate::env::{KinovaFeedingConfig, KinovaFeedingEnv};
 use crate::food::{FoodKind, Setting};
 use crate::sim::AttemptReport;
+use hil_workload::stats::{Alternative, fisher_exact};
 
 /// What to calibrate.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,6 +95,11 @@ pub struct SettingCell {
     pub se: f64,
     /// Published rate in this setting.
     pub published: Option<f64>,
+    /// How likely a difference this large is by chance alone: Fisher's
+    /// exact two-sided test that the counted attempts here and the
+    /// published ones ([`PUBLISHED_TRIALS_PER_SETTING`]) share one success
+    /// rate. `None` when no attempt counted.
+    pub p_value: Option<f64>,
 }
 
 /// One (food, action) cell.
@@ -119,6 +126,9 @@ pub struct CalibrationRow {
     pub published: Option<f64>,
     /// The same cell per setting.
     pub by_setting: Vec<SettingCell>,
+    /// As [`SettingCell::p_value`], over the row's settings together (the
+    /// published successes of each setting summed).
+    pub p_value: Option<f64>,
 }
 
 /// One simulated attempt, for the attempt log.
@@ -163,6 +173,12 @@ pub struct CalibrationReport {
     /// meets [`target`](Self::target) in one run with these trial counts:
     /// how often a run *can* meet it, whatever the model.
     pub perfect_simulator_meets_target: f64,
+    /// How the overall rows stand against the published ones by the
+    /// p-values of [`CalibrationRow::p_value`]: whether any difference is
+    /// larger than the sampling noise of both tables explains.
+    pub consistency: Consistency,
+    /// The same over the per-setting cells.
+    pub consistency_by_setting: Consistency,
     /// How long an item had to stay on the lifted fork (s).
     pub hold_s: f64,
     /// What turned the tine row by the actions' roll.
@@ -322,7 +338,10 @@ pub fn calibrate_with(
             .collect(),
     );
     let target = CalibrationTarget::ACCEPTANCE;
+    let (consistency, consistency_by_setting) = consistency_of(&rows);
     Ok(CalibrationReport {
+        consistency,
+        consistency_by_setting,
         noise_floor,
         target,
         meets_target: target.is_met(mean_abs_error, max_abs_error),
@@ -508,6 +527,77 @@ pub fn binomial_se(successes: usize, trials: usize) -> f64 {
     (p * (1.0 - p) / trials as f64).sqrt()
 }
 
+/// Fisher's exact two-sided p-value that the counted attempts of `t` and
+/// the published attempts behind `published` (one rate per setting, each
+/// over [`PUBLISHED_TRIALS_PER_SETTING`] trials) share one success rate;
+/// `None` when no attempt counted.
+fn consistency_p(t: &Tally, published: &[f64]) -> Option<f64> {
+    let n = PUBLISHED_TRIALS_PER_SETTING as f64;
+    // A published rate is a count over its trials (0.4 = 4 of 10).
+    let successes: u64 = published.iter().map(|p| (p * n).round() as u64).sum();
+    let trials = (PUBLISHED_TRIALS_PER_SETTING * published.len()) as u64;
+    let counted = (t.trials - t.discarded) as u64;
+    if published.is_empty() {
+        return None;
+    }
+    fisher_exact(
+        t.successes as u64,
+        counted,
+        successes,
+        trials,
+        Alternative::TwoSided,
+    )
+    .ok()
+    .map(|r| r.p_value)
+}
+
+/// Whether a table's differences from the published one exceed what the
+/// sampling noise of both explains: the per-cell p-values of Fisher's exact
+/// test (see [`CalibrationRow::p_value`]) summarised.
+///
+/// Read it with the multiplicity in mind: among 18 cells of a simulator
+/// whose every rate is the published one, about one in twenty would fall
+/// below 0.05 by chance (fewer: tests on counts are conservative).
+/// `smallest_p_adjusted` accounts for that.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Consistency {
+    /// Cells tested (those with counted attempts).
+    pub cells: usize,
+    /// Cells whose p-value is below 0.05.
+    pub below_0_05: usize,
+    /// The cell with the smallest p-value (`carrot VS90`, or
+    /// `carrot VS90 lettuce` per setting); empty when no cell was tested.
+    pub least_consistent: String,
+    /// Its p-value.
+    pub smallest_p: f64,
+    /// The smallest p-value times the number of cells, at most 1
+    /// (Bonferroni): at most this likely is a cell this far off anywhere
+    /// in the table if every simulated rate were the published one.
+    pub smallest_p_adjusted: f64,
+}
+
+impl Consistency {
+    /// Summarises labelled p-values (`None`: the cell was not tested).
+    pub fn over(cells: impl IntoIterator<Item = (String, Option<f64>)>) -> Self {
+        let tested: Vec<(String, f64)> = cells
+            .into_iter()
+            .filter_map(|(label, p)| p.map(|p| (label, p)))
+            .collect();
+        let (least_consistent, smallest_p) = tested
+            .iter()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .cloned()
+            .unwrap_or((String::new(), 1.0));
+        Consistency {
+            cells: tested.len(),
+            below_0_05: tested.iter().filter(|(_, p)| *p < 0.05).count(),
+            least_consistent,
+            smallest_p,
+            smallest_p_adjusted: (smallest_p * tested.len() as f64).min(1.0),
+        }
+    }
+}
+
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
@@ -531,14 +621,171 @@ fn count(records: &[&&AttemptRecord]) -> Tally {
         .iter()
         .filter(|r| r.report.counted && r.report.success)
         .count();
-    let counted = records.len() - discarded;
-    Tally {
-        trials: records.len(),
-        discarded,
-        successes,
-        rate: successes as f64 / counted.max(1) as f64,
-        se: binomial_se(successes, counted),
+    Tally::of(records.len(), discarded, successes)
+}
+
+impl Tally {
+    /// The rate over the `trials − discarded` that counted, and its SE.
+    fn of(trials: usize, discarded: usize, successes: usize) -> Self {
+        let counted = trials - discarded;
+        Tally {
+            trials,
+            discarded,
+            successes,
+            rate: successes as f64 / counted.max(1) as f64,
+            se: binomial_se(successes, counted),
+        }
     }
+}
+
+/// The [`Consistency`] of the overall rows and of the per-setting cells.
+fn consistency_of(rows: &[CalibrationRow]) -> (Consistency, Consistency) {
+    let overall = Consistency::over(
+        rows.iter()
+            .map(|r| (format!("{} {}", r.food, r.action), r.p_value)),
+    );
+    let by_setting = Consistency::over(rows.iter().flat_map(|r| {
+        r.by_setting.iter().map(move |c| {
+            (
+                format!("{} {} {}", r.food, r.action, c.setting.name()),
+                c.p_value,
+            )
+        })
+    }));
+    (overall, by_setting)
+}
+
+/// Calibration runs under several master seeds: the spread of one run's
+/// figures (how a single run reads against the acceptance) and every
+/// run's attempts pooled (how the simulator itself does, with the
+/// simulated side's noise shrunk by the number of runs).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CalibrationOverSeeds {
+    /// The master seeds, one run each.
+    pub seeds: Vec<u64>,
+    /// Mean |simulated − published| over the overall cells: mean, SD and
+    /// standard error over the runs.
+    pub mean_abs_error: Stat,
+    /// The worst cell's |simulated − published|, over the runs.
+    pub max_abs_error: Stat,
+    /// The acceptance the runs are read against.
+    pub target: CalibrationTarget,
+    /// Runs that meet [`target`](Self::target).
+    pub runs_meeting_target: usize,
+    /// The chance that one run of a perfect simulator with the same trial
+    /// counts meets it, averaged over the runs (the counts differ only by
+    /// discarded attempts).
+    pub perfect_simulator_meets_target: f64,
+    /// Every run's attempts together, per (food, action) and setting, with
+    /// their p-values against the published counts.
+    pub pooled: Vec<CalibrationRow>,
+    /// [`Consistency`] of the pooled overall rows.
+    pub pooled_consistency: Consistency,
+    /// [`Consistency`] of the pooled per-setting cells.
+    pub pooled_consistency_by_setting: Consistency,
+    /// The runs, in seed order.
+    pub runs: Vec<CalibrationReport>,
+}
+
+/// Runs [`calibrate_with`] once per seed in `seeds` (`opts.seed` is
+/// ignored) and summarises the runs; `progress` gets `(run, done, total)`.
+pub fn calibrate_over_seeds(
+    opts: &CalibrationOptions,
+    seeds: &[u64],
+    progress: &(dyn Fn(usize, usize, usize) + Sync),
+    log: &mut dyn FnMut(&AttemptRecord),
+) -> Result<CalibrationOverSeeds> {
+    if seeds.is_empty() {
+        return Err(HilError::invalid_parameter(
+            "seeds",
+            "[]",
+            "needs at least one seed",
+        ));
+    }
+    let mut runs = Vec::with_capacity(seeds.len());
+    for (i, &seed) in seeds.iter().enumerate() {
+        let run_opts = CalibrationOptions {
+            seed,
+            ..opts.clone()
+        };
+        runs.push(calibrate_with(&run_opts, &|d, t| progress(i, d, t), log)?);
+    }
+    Ok(summarise_runs(seeds.to_vec(), runs))
+}
+
+/// The summary of runs of one calibration under different seeds.
+fn summarise_runs(seeds: Vec<u64>, runs: Vec<CalibrationReport>) -> CalibrationOverSeeds {
+    let of =
+        |f: &dyn Fn(&CalibrationReport) -> f64| Stat::of(&runs.iter().map(f).collect::<Vec<_>>());
+    let pooled = pool_rows(&runs);
+    let (pooled_consistency, pooled_consistency_by_setting) = consistency_of(&pooled);
+    let target = CalibrationTarget::ACCEPTANCE;
+    CalibrationOverSeeds {
+        mean_abs_error: of(&|r| r.mean_abs_error),
+        max_abs_error: of(&|r| r.max_abs_error),
+        target,
+        runs_meeting_target: runs.iter().filter(|r| r.meets_target).count(),
+        perfect_simulator_meets_target: of(&|r| r.perfect_simulator_meets_target).mean,
+        pooled,
+        pooled_consistency,
+        pooled_consistency_by_setting,
+        seeds,
+        runs,
+    }
+}
+
+/// The rows of `runs` (same foods, actions and settings) with their counts
+/// summed and rates, SEs and p-values recomputed.
+fn pool_rows(runs: &[CalibrationReport]) -> Vec<CalibrationRow> {
+    let Some(first) = runs.first() else {
+        return Vec::new();
+    };
+    let sum = |f: &dyn Fn(&CalibrationReport) -> (usize, usize, usize)| {
+        runs.iter()
+            .map(f)
+            .fold((0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2))
+    };
+    first
+        .rows
+        .iter()
+        .enumerate()
+        .map(|(i, row)| {
+            let by_setting: Vec<SettingCell> = row
+                .by_setting
+                .iter()
+                .enumerate()
+                .map(|(j, cell)| {
+                    let (n, d, s) = sum(&|r| {
+                        let c = &r.rows[i].by_setting[j];
+                        (c.trials, c.discarded, c.successes)
+                    });
+                    let t = Tally::of(n, d, s);
+                    SettingCell {
+                        p_value: consistency_p(&t, &cell.published.into_iter().collect::<Vec<_>>()),
+                        trials: t.trials,
+                        discarded: t.discarded,
+                        successes: t.successes,
+                        rate: t.rate,
+                        se: t.se,
+                        ..cell.clone()
+                    }
+                })
+                .collect();
+            let (n, d, s) = sum(&|r| (r.rows[i].trials, r.rows[i].discarded, r.rows[i].successes));
+            let t = Tally::of(n, d, s);
+            let published: Vec<f64> = by_setting.iter().filter_map(|c| c.published).collect();
+            CalibrationRow {
+                p_value: consistency_p(&t, &published),
+                trials: t.trials,
+                discarded: t.discarded,
+                successes: t.successes,
+                rate: t.rate,
+                se: t.se,
+                by_setting,
+                ..row.clone()
+            }
+        })
+        .collect()
 }
 
 /// Groups attempt records into rows per (food, action), in job order.
@@ -557,6 +804,7 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                     let here: Vec<&&AttemptRecord> =
                         cell.iter().filter(|r| r.setting == setting).collect();
                     let t = count(&here);
+                    let published = food.published_rates_in(setting)[a];
                     SettingCell {
                         setting,
                         trials: t.trials,
@@ -564,7 +812,8 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                         successes: t.successes,
                         rate: t.rate,
                         se: t.se,
-                        published: Some(food.published_rates_in(setting)[a]),
+                        published: Some(published),
+                        p_value: consistency_p(&t, &[published]),
                     }
                 })
                 .collect();
@@ -585,7 +834,12 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                         / t.trials.max(1) as f64,
                 )
             };
+            let published_per_setting: Vec<f64> = by_setting
+                .iter()
+                .map(|c| food.published_rates_in(c.setting)[a])
+                .collect();
             rows.push(CalibrationRow {
+                p_value: consistency_p(&t, &published_per_setting),
                 food: food.name().into(),
                 action: action.name.into(),
                 trials: t.trials,
@@ -676,6 +930,7 @@ mod tests {
             rate: 0.0,
             se: 0.0,
             published: Some(published),
+            p_value: None,
         };
         CalibrationRow {
             food: "banana".into(),
@@ -686,6 +941,7 @@ mod tests {
             rate: cell.rate,
             se: cell.se,
             published: cell.published,
+            p_value: cell.p_value,
             by_setting: vec![cell],
         }
     }
@@ -764,5 +1020,94 @@ mod tests {
         assert_eq!(vs0.se, binomial_se(1, 2));
         assert_eq!(vs0.by_setting[0].discarded, 2);
         assert_eq!(vs0.by_setting[0].rate, 0.5);
+        // The consistency test sees the 2 counted attempts (1 success)
+        // against the published 0 of 10: of the 12 attempts' single
+        // success, the simulated 2 hold it with probability 2/12, and the
+        // other table (0 of 2) is likelier, so p = 2/12.
+        let p = vs0.by_setting[0].p_value.unwrap();
+        assert!((p - 2.0 / 12.0).abs() < 1e-12, "{p}");
+        assert_eq!(vs0.p_value, vs0.by_setting[0].p_value);
+    }
+
+    #[test]
+    fn runs_over_seeds_pool_their_counts_and_summarise_their_errors() {
+        let opts = CalibrationOptions {
+            foods: vec![FoodKind::Carrot],
+            settings: vec![Setting::Isolated, Setting::Lettuce],
+            trials: 2,
+            ..CalibrationOptions::default()
+        };
+        let mut logged = 0;
+        let over =
+            calibrate_over_seeds(&opts, &[3, 4], &|_, _, _| {}, &mut |_| logged += 1).unwrap();
+        assert_eq!(logged, 2 * 6 * 2);
+        let single: Vec<CalibrationReport> = [3, 4]
+            .iter()
+            .map(|&seed| {
+                calibrate_with(
+                    &CalibrationOptions {
+                        seed,
+                        ..opts.clone()
+                    },
+                    &|_, _| {},
+                    &mut |_| {},
+                )
+                .unwrap()
+            })
+            .collect();
+        // Each run is the run of its seed alone (timings aside).
+        for (run, alone) in over.runs.iter().zip(&single) {
+            assert_eq!(run.rows, alone.rows);
+            assert_eq!(run.mean_abs_error, alone.mean_abs_error);
+        }
+        assert_eq!(over.seeds, vec![3, 4]);
+        let means: Vec<f64> = single.iter().map(|r| r.mean_abs_error).collect();
+        assert_eq!(over.mean_abs_error, Stat::of(&means));
+        assert_eq!(
+            over.runs_meeting_target,
+            single.iter().filter(|r| r.meets_target).count()
+        );
+        // Pooled counts are the sums; rates and p-values follow from them.
+        for (i, row) in over.pooled.iter().enumerate() {
+            let (a, b) = (&single[0].rows[i], &single[1].rows[i]);
+            assert_eq!(row.successes, a.successes + b.successes);
+            assert_eq!(row.trials, 4);
+            let t = Tally::of(row.trials, row.discarded, row.successes);
+            assert_eq!((row.rate, row.se), (t.rate, t.se));
+            let published = [
+                FoodKind::Carrot.published_rates_in(Setting::Isolated)[i],
+                FoodKind::Carrot.published_rates_in(Setting::Lettuce)[i],
+            ];
+            assert_eq!(row.p_value, consistency_p(&t, &published));
+            for (j, cell) in row.by_setting.iter().enumerate() {
+                assert_eq!(
+                    cell.successes,
+                    a.by_setting[j].successes + b.by_setting[j].successes
+                );
+            }
+        }
+        assert_eq!(over.pooled_consistency.cells, 6);
+        let err = calibrate_over_seeds(&opts, &[], &|_, _, _| {}, &mut |_| {}).unwrap_err();
+        assert!(matches!(err, HilError::InvalidParameter { .. }), "{err:?}");
+    }
+
+    #[test]
+    fn consistency_names_the_least_consistent_cell_and_adjusts_for_the_count() {
+        let c = Consistency::over([
+            ("carrot VS0".to_string(), Some(0.4)),
+            ("carrot VS90".to_string(), Some(0.01)),
+            ("carrot TV0".to_string(), None),
+            ("banana TA0".to_string(), Some(0.04)),
+        ]);
+        assert_eq!(c.cells, 3);
+        assert_eq!(c.below_0_05, 2);
+        assert_eq!(c.least_consistent, "carrot VS90");
+        assert_eq!(c.smallest_p, 0.01);
+        assert!((c.smallest_p_adjusted - 0.03).abs() < 1e-12);
+        // Bonferroni is capped at 1; no tested cell leaves p = 1.
+        let many = Consistency::over((0..30).map(|i| (i.to_string(), Some(0.5))));
+        assert_eq!(many.smallest_p_adjusted, 1.0);
+        let none = Consistency::over([("x".to_string(), None)]);
+        assert_eq!((none.cells, none.smallest_p), (0, 1.0));
     }
 }

@@ -53,9 +53,9 @@ mod without_physics;
 
 #[cfg(feature = "physics")]
 pub use calibrate::{
-    AttemptRecord, CalibrationOptions, CalibrationReport, CalibrationRow, CalibrationTarget,
-    PUBLISHED_TRIALS_PER_SETTING, SettingCell, TARGET_GRID, calibrate, calibrate_with,
-    expected_abs_error_of_a_perfect_simulator,
+    AttemptRecord, CalibrationOptions, CalibrationOverSeeds, CalibrationReport, CalibrationRow,
+    CalibrationTarget, Consistency, PUBLISHED_TRIALS_PER_SETTING, SettingCell, TARGET_GRID,
+    calibrate, calibrate_over_seeds, calibrate_with, expected_abs_error_of_a_perfect_simulator,
 };
 #[cfg(feature = "physics")]
 pub use controller::{ACTIONS, Action, RollBy};

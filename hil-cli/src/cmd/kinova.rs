@@ -17,8 +17,9 @@ use std::path::{Path, PathBuf};
 use hil_core::{HilError, Result};
 use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyResult};
 use hil_kinova_mujoco::{
-    CalibrationOptions, FoodKind, KeyframeRecorder, KeyframeWriter, KinovaFeedingConfig,
-    KinovaFeedingEnv, Label, RenderingEnv, RollBy, calibrate_with, parse_labels,
+    CalibrationOptions, CalibrationReport, CalibrationRow, Consistency, FoodKind, KeyframeRecorder,
+    KeyframeWriter, KinovaFeedingConfig, KinovaFeedingEnv, Label, RenderingEnv, RollBy,
+    calibrate_over_seeds, parse_labels,
 };
 
 /// Arguments of `hil kinova`.
@@ -45,6 +46,11 @@ pub struct CalibrateArgs {
     /// Master seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Runs this many master seeds (`--seed`, `--seed`+1, ...) and reports
+    /// how one run's figures spread over them (mean ± standard error, runs
+    /// meeting the target) and every run's attempts pooled.
+    #[arg(long, default_value_t = 1)]
+    pub seeds: u64,
     /// Foods to run (default: the three calibrated ones, banana, carrot,
     /// cantaloupe; the derived honeydew, kiwi and celery may be named).
     #[arg(long, value_delimiter = ',')]
@@ -165,6 +171,13 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             "must be at least 1",
         ));
     }
+    if args.seeds == 0 {
+        return Err(HilError::invalid_parameter(
+            "--seeds",
+            "0",
+            "must be at least 1",
+        ));
+    }
     if args.threads == Some(0) {
         return Err(HilError::invalid_parameter(
             "--threads",
@@ -194,9 +207,15 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
     };
     let quiet = args.quiet;
-    let progress = |done: usize, total: usize| {
+    let runs = args.seeds;
+    let progress = |run: usize, done: usize, total: usize| {
         if !quiet && (done % 10 == 0 || done == total) {
-            eprint!("\rsimulated {done}/{total} attempts");
+            let of_runs = if runs > 1 {
+                format!(" (seed {} of {runs})", run + 1)
+            } else {
+                String::new()
+            };
+            eprint!("\rsimulated {done}/{total} attempts{of_runs}");
             if done == total {
                 eprintln!();
             }
@@ -210,8 +229,9 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         )),
         None => None,
     };
+    let seeds: Vec<u64> = (0..args.seeds).map(|i| args.seed.wrapping_add(i)).collect();
     let mut records = Vec::new();
-    let report = calibrate_with(&opts, &progress, &mut |r| {
+    let mut over = calibrate_over_seeds(&opts, &seeds, &progress, &mut |r| {
         if log_file.is_some() {
             records.push(r.clone());
         }
@@ -224,36 +244,124 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         }
         w.flush().map_err(|e| HilError::io("write", path, e))?;
     }
-    if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| HilError::serde("report", e))?
-        );
+    if over.runs.len() == 1 {
+        let report = over.runs.remove(0);
+        if args.json {
+            print_json(&report)?;
+        } else {
+            print_run(&opts, &report);
+        }
         return Ok(());
     }
+    if args.json {
+        return print_json(&over);
+    }
+    let first = &over.runs[0];
+    println!(
+        "{} runs, master seeds {}..={}; attempts of all runs pooled, rate ± binomial SE (published):",
+        over.runs.len(),
+        seeds[0],
+        seeds[seeds.len() - 1]
+    );
+    print_tool(first.roll_by);
+    print_table(&over.pooled);
+    for (run, seed) in over.runs.iter().zip(&seeds) {
+        println!(
+            "seed {seed}: mean |simulated - published| {:.3}, largest {:.3}: target {}",
+            run.mean_abs_error,
+            run.max_abs_error,
+            met(run.meets_target)
+        );
+    }
+    let t = over.target;
+    println!(
+        "over {} runs (mean ± SE): mean |simulated - published| {:.3} ± {:.3}, largest {:.3} ± {:.3}; target (mean <= {:.2}, no cell off by more than {:.2}) met in {} of {} runs, where a perfect simulator meets it in {:.0}% of runs",
+        over.runs.len(),
+        over.mean_abs_error.mean,
+        over.mean_abs_error.se,
+        over.max_abs_error.mean,
+        over.max_abs_error.se,
+        t.mean_abs_error,
+        t.worst_cell,
+        over.runs_meeting_target,
+        over.runs.len(),
+        100.0 * over.perfect_simulator_meets_target
+    );
+    print_consistency("pooled overall cells", &over.pooled_consistency);
+    print_consistency(
+        "pooled per-setting cells",
+        &over.pooled_consistency_by_setting,
+    );
+    print_throughput(first);
+    Ok(())
+}
+
+fn print_json(value: &impl serde::Serialize) -> Result<()> {
+    println!(
+        "{}",
+        serde_json::to_string_pretty(value).map_err(|e| HilError::serde("report", e))?
+    );
+    Ok(())
+}
+
+fn met(yes: bool) -> &'static str {
+    if yes { "met" } else { "not met" }
+}
+
+/// One run: the table and how it stands against the target.
+fn print_run(opts: &CalibrationOptions, report: &CalibrationReport) {
     let per_setting = opts.trials / opts.settings.len();
     println!(
         "Simulated success rate (published rate) per action; {} trials each ({} per setting).",
         opts.trials, per_setting
     );
+    print_tool(report.roll_by);
+    print_table(&report.rows);
+    println!(
+        "mean |simulated - published| = {:.3} overall (largest {:.3}), {:.3} per setting; hold {:.1} s",
+        report.mean_abs_error,
+        report.max_abs_error,
+        report.mean_abs_error_by_setting,
+        report.hold_s,
+    );
+    println!(
+        "a perfect simulator (true rates = the published ones) would still average {:.3}: the sampling noise of {} published trials per setting and of these",
+        report.noise_floor,
+        hil_kinova_mujoco::PUBLISHED_TRIALS_PER_SETTING
+    );
+    let t = report.target;
+    println!(
+        "target (mean <= {:.2}, no cell off by more than {:.2}): {}; a perfect simulator meets it in {:.0}% of runs with these trial counts",
+        t.mean_abs_error,
+        t.worst_cell,
+        met(report.meets_target),
+        100.0 * report.perfect_simulator_meets_target
+    );
+    print_consistency("overall cells", &report.consistency);
+    print_consistency("per-setting cells", &report.consistency_by_setting);
+    print_throughput(report);
+}
+
+fn print_tool(roll_by: RollBy) {
     println!(
         "Simulated attempts with synthetic food properties, tool `{}`{}; published: Feng et al. 2019.",
-        report.roll_by.name(),
-        match report.roll_by {
+        roll_by.name(),
+        match roll_by {
             RollBy::ArmYaw => " (the published data set's rigid fork)",
             RollBy::ForkGamma =>
                 " (the study's 2-DoF fork: not the tool the published rates measured)",
         }
     );
-    let header = || {
-        print!("{:<22}", "food");
-        for a in hil_envs::feeding::action_space().names() {
-            print!("{a:>18}");
-        }
-        println!();
-    };
-    header();
-    for chunk in report.rows.chunks(6) {
+}
+
+/// The rows, one line per food and one per setting under it.
+fn print_table(rows: &[CalibrationRow]) {
+    print!("{:<22}", "food");
+    for a in hil_envs::feeding::action_space().names() {
+        print!("{a:>18}");
+    }
+    println!();
+    for chunk in rows.chunks(6) {
         print!("{:<22}", chunk[0].food);
         for r in chunk {
             print!("{:>18}", cell(r.rate, r.se, r.published));
@@ -268,12 +376,33 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             println!();
         }
     }
+    let discarded: usize = rows.iter().map(|r| r.discarded).sum();
     println!(
-        "mean |simulated - published| = {:.3} overall (largest {:.3}), {:.3} per setting; hold {:.1} s; {:.1} attempts/s on {} threads ({:.1} per core); {:.0} steps per attempt at {:.1} µs per mj_step; {:.1}% of time outside mj_step",
-        report.mean_abs_error,
-        report.max_abs_error,
-        report.mean_abs_error_by_setting,
-        report.hold_s,
+        "{discarded} of {} attempts discarded (fewer than {} tines touched the item, as in the published data set); rates are over the rest",
+        rows.iter().map(|r| r.trials).sum::<usize>(),
+        hil_kinova_mujoco::MIN_TINES_TOUCHED
+    );
+}
+
+fn print_consistency(what: &str, c: &Consistency) {
+    println!(
+        "chance alone (Fisher's exact test per cell, simulated vs published counts), {what}: {} of {} below p = 0.05; least consistent {} (p = {:.3}; {:.3} after Bonferroni over {} cells)",
+        c.below_0_05,
+        c.cells,
+        if c.least_consistent.is_empty() {
+            "-"
+        } else {
+            &c.least_consistent
+        },
+        c.smallest_p,
+        c.smallest_p_adjusted,
+        c.cells
+    );
+}
+
+fn print_throughput(report: &CalibrationReport) {
+    println!(
+        "{:.1} attempts/s on {} threads ({:.1} per core); {:.0} steps per attempt at {:.1} µs per mj_step; {:.1}% of time outside mj_step",
         report.attempts_per_second,
         report.threads,
         report.attempts_per_second_per_core,
@@ -281,30 +410,6 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         report.micros_per_step,
         100.0 * report.overhead_share
     );
-    println!(
-        "a perfect simulator (true rates = the published ones) would still average {:.3}: the sampling noise of {} published trials per setting and of these",
-        report.noise_floor,
-        hil_kinova_mujoco::PUBLISHED_TRIALS_PER_SETTING
-    );
-    let t = report.target;
-    println!(
-        "target (mean <= {:.2}, no cell off by more than {:.2}): {}; a perfect simulator meets it in {:.0}% of runs with these trial counts",
-        t.mean_abs_error,
-        t.worst_cell,
-        if report.meets_target {
-            "met"
-        } else {
-            "not met"
-        },
-        100.0 * report.perfect_simulator_meets_target
-    );
-    let discarded: usize = report.rows.iter().map(|r| r.discarded).sum();
-    println!(
-        "{discarded} of {} attempts discarded (fewer than {} tines touched the item, as in the published data set); rates are over the rest",
-        report.rows.iter().map(|r| r.trials).sum::<usize>(),
-        hil_kinova_mujoco::MIN_TINES_TOUCHED
-    );
-    Ok(())
 }
 
 fn cell(rate: f64, se: f64, published: Option<f64>) -> String {

@@ -57,6 +57,29 @@ fn calibrate_prints_rates_beside_the_published_ones() {
     assert_eq!(v["meets_target"], mean <= 0.06 && worst <= 0.15);
     let chance = v["perfect_simulator_meets_target"].as_f64().unwrap();
     assert!(chance > 0.0 && chance < 0.5, "{chance}");
+    // Every cell with a counted attempt has a p-value (null only when
+    // all were discarded), and the summary names the least consistent.
+    let p_values: Vec<f64> = rows
+        .iter()
+        .filter_map(|r| {
+            let counted = r["trials"].as_u64() != r["discarded"].as_u64();
+            assert_eq!(r["p_value"].is_f64(), counted, "{r}");
+            r["p_value"].as_f64()
+        })
+        .collect();
+    assert!(p_values.iter().all(|p| (0.0..=1.0).contains(p)));
+    let c = &v["consistency"];
+    assert_eq!(c["cells"].as_u64().unwrap() as usize, p_values.len());
+    let smallest = p_values.iter().copied().fold(1.0, f64::min);
+    assert_eq!(c["smallest_p"].as_f64().unwrap(), smallest);
+    assert!(
+        c["least_consistent"]
+            .as_str()
+            .unwrap()
+            .starts_with("carrot "),
+        "{c}"
+    );
+    assert!(v["consistency_by_setting"]["cells"].as_u64().unwrap() <= 18);
 
     let out = hil(&["kinova", "calibrate", "--foods", "apple"]);
     assert!(!out.status.success());

@@ -165,6 +165,10 @@ pub struct CalibrationReport {
     /// ones on the trials counted here). The floor `mean_abs_error` is to
     /// be read against.
     pub noise_floor: f64,
+    /// The largest |simulated − published| over the overall rows that the
+    /// perfect simulator of `noise_floor` is expected to show: what the
+    /// worst cell (`max_abs_error`) is to be read against.
+    pub noise_floor_worst_cell: f64,
     /// The acceptance this table is read against.
     pub target: CalibrationTarget,
     /// Whether this run meets [`target`](Self::target).
@@ -339,7 +343,9 @@ pub fn calibrate_with(
     );
     let target = CalibrationTarget::ACCEPTANCE;
     let (consistency, consistency_by_setting) = consistency_of(&rows);
+    let noise_floor_worst_cell = expected_worst_error_of_a_perfect_simulator(&compared);
     Ok(CalibrationReport {
+        noise_floor_worst_cell,
         consistency,
         consistency_by_setting,
         noise_floor,
@@ -384,6 +390,33 @@ pub fn expected_abs_error_of_a_perfect_simulator(row: &CalibrationRow) -> f64 {
     perfect_simulator_errors(row)
         .iter()
         .map(|(e, p)| e * p)
+        .sum()
+}
+
+/// The expected largest |simulated − published| over `rows` for a
+/// perfect simulator (see [`expected_abs_error_of_a_perfect_simulator`]):
+/// the cells are independent, so the largest error is at most `x` with
+/// the product of the cells' probabilities of being at most `x`; errors
+/// are binned to 1/[`TARGET_GRID`] as in
+/// [`CalibrationTarget::chance_a_perfect_simulator_meets`].
+pub fn expected_worst_error_of_a_perfect_simulator(rows: &[&CalibrationRow]) -> f64 {
+    let bins = TARGET_GRID as usize;
+    // cdf[b]: probability that every cell so far is within b bins.
+    let mut cdf = vec![1.0; bins + 1];
+    for row in rows {
+        let mut cell = vec![0.0; bins + 1];
+        for (e, p) in perfect_simulator_errors(row) {
+            cell[((e * TARGET_GRID).round() as usize).min(bins)] += p;
+        }
+        let mut within = 0.0;
+        for (b, c) in cdf.iter_mut().enumerate() {
+            within += cell[b];
+            *c *= within;
+        }
+    }
+    // E[max] = Σ_b b·P(max = b bins), P(max = b) = cdf[b] − cdf[b − 1].
+    (1..=bins)
+        .map(|b| b as f64 / TARGET_GRID * (cdf[b] - cdf[b - 1]))
         .sum()
 }
 
@@ -574,6 +607,12 @@ pub struct Consistency {
     /// (Bonferroni): at most this likely is a cell this far off anywhere
     /// in the table if every simulated rate were the published one.
     pub smallest_p_adjusted: f64,
+    /// At most this likely are `below_0_05` or more such cells if every
+    /// simulated rate were the published one: the cells are independent
+    /// and each falls below 0.05 with probability at most 0.05, so their
+    /// count is at most a binomial(cells, 0.05) one. Small when the table
+    /// differs in many cells, none of them decisively.
+    pub p_this_many_below_0_05: f64,
 }
 
 impl Consistency {
@@ -588,9 +627,14 @@ impl Consistency {
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .cloned()
             .unwrap_or((String::new(), 1.0));
+        let below_0_05 = tested.iter().filter(|(_, p)| *p < 0.05).count();
         Consistency {
             cells: tested.len(),
-            below_0_05: tested.iter().filter(|(_, p)| *p < 0.05).count(),
+            below_0_05,
+            p_this_many_below_0_05: binomial_pmf(tested.len(), 0.05)[below_0_05..]
+                .iter()
+                .sum::<f64>()
+                .min(1.0),
             least_consistent,
             smallest_p,
             smallest_p_adjusted: (smallest_p * tested.len() as f64).min(1.0),
@@ -668,6 +712,12 @@ pub struct CalibrationOverSeeds {
     pub mean_abs_error: Stat,
     /// The worst cell's |simulated − published|, over the runs.
     pub max_abs_error: Stat,
+    /// [`CalibrationReport::noise_floor`] averaged over the runs: what
+    /// `mean_abs_error` is to be read against.
+    pub noise_floor: f64,
+    /// [`CalibrationReport::noise_floor_worst_cell`] averaged over the
+    /// runs: what `max_abs_error` is to be read against.
+    pub noise_floor_worst_cell: f64,
     /// The acceptance the runs are read against.
     pub target: CalibrationTarget,
     /// Runs that meet [`target`](Self::target).
@@ -723,6 +773,8 @@ fn summarise_runs(seeds: Vec<u64>, runs: Vec<CalibrationReport>) -> CalibrationO
     CalibrationOverSeeds {
         mean_abs_error: of(&|r| r.mean_abs_error),
         max_abs_error: of(&|r| r.max_abs_error),
+        noise_floor: of(&|r| r.noise_floor).mean,
+        noise_floor_worst_cell: of(&|r| r.noise_floor_worst_cell).mean,
         target,
         runs_meeting_target: runs.iter().filter(|r| r.meets_target).count(),
         perfect_simulator_meets_target: of(&|r| r.perfect_simulator_meets_target).mean,
@@ -991,6 +1043,29 @@ mod tests {
     }
 
     #[test]
+    fn a_perfect_simulators_expected_worst_cell_is_the_mean_of_the_larger_error() {
+        let rows = [one_setting_row(0.5, 20), one_setting_row(0.3, 20)];
+        let (a, b) = (
+            perfect_simulator_errors(&rows[0]),
+            perfect_simulator_errors(&rows[1]),
+        );
+        let exact: f64 = a
+            .iter()
+            .flat_map(|(ea, pa)| b.iter().map(move |(eb, pb)| ea.max(*eb) * pa * pb))
+            .sum();
+        let e = expected_worst_error_of_a_perfect_simulator(&rows.iter().collect::<Vec<_>>());
+        assert!((e - exact).abs() < 1e-9, "{e} vs {exact}");
+        // The worst of two is above either cell's own mean error.
+        let one = expected_abs_error_of_a_perfect_simulator(&rows[0]);
+        assert!(e > one + 0.01, "{e} {one}");
+        let certain = [one_setting_row(1.0, 20)];
+        assert_eq!(
+            expected_worst_error_of_a_perfect_simulator(&certain.iter().collect::<Vec<_>>()),
+            0.0
+        );
+    }
+
+    #[test]
     fn a_target_allows_an_error_equal_to_its_bound_and_nothing_above() {
         let t = CalibrationTarget::ACCEPTANCE;
         assert!(t.is_met(0.06, 0.15));
@@ -1104,10 +1179,14 @@ mod tests {
         assert_eq!(c.least_consistent, "carrot VS90");
         assert_eq!(c.smallest_p, 0.01);
         assert!((c.smallest_p_adjusted - 0.03).abs() < 1e-12);
+        // Two or more of three cells below 0.05 by chance: 3·0.05²·0.95 + 0.05³.
+        let two_of_three = 3.0 * 0.05f64.powi(2) * 0.95 + 0.05f64.powi(3);
+        assert!((c.p_this_many_below_0_05 - two_of_three).abs() < 1e-12);
         // Bonferroni is capped at 1; no tested cell leaves p = 1.
         let many = Consistency::over((0..30).map(|i| (i.to_string(), Some(0.5))));
         assert_eq!(many.smallest_p_adjusted, 1.0);
         let none = Consistency::over([("x".to_string(), None)]);
         assert_eq!((none.cells, none.smallest_p), (0, 1.0));
+        assert!((none.p_this_many_below_0_05 - 1.0).abs() < 1e-12);
     }
 }

@@ -275,12 +275,14 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     }
     let t = over.target;
     println!(
-        "over {} runs (mean ± SE): mean |simulated - published| {:.3} ± {:.3}, largest {:.3} ± {:.3}; target (mean <= {:.2}, no cell off by more than {:.2}) met in {} of {} runs, where a perfect simulator meets it in {:.0}% of runs",
+        "over {} runs (mean ± SE): mean |simulated - published| {:.3} ± {:.3}, largest {:.3} ± {:.3} (a perfect simulator: {:.3} and {:.3}); target (mean <= {:.2}, no cell off by more than {:.2}) met in {} of {} runs, where a perfect simulator meets it in {:.0}% of runs",
         over.runs.len(),
         over.mean_abs_error.mean,
         over.mean_abs_error.se,
         over.max_abs_error.mean,
         over.max_abs_error.se,
+        over.noise_floor,
+        over.noise_floor_worst_cell,
         t.mean_abs_error,
         t.worst_cell,
         over.runs_meeting_target,
@@ -325,8 +327,9 @@ fn print_run(opts: &CalibrationOptions, report: &CalibrationReport) {
         report.hold_s,
     );
     println!(
-        "a perfect simulator (true rates = the published ones) would still average {:.3}: the sampling noise of {} published trials per setting and of these",
+        "a perfect simulator (true rates = the published ones) would still average {:.3}, with a worst cell of {:.3} expected: the sampling noise of {} published trials per setting and of these",
         report.noise_floor,
+        report.noise_floor_worst_cell,
         hil_kinova_mujoco::PUBLISHED_TRIALS_PER_SETTING
     );
     let t = report.target;
@@ -386,9 +389,10 @@ fn print_table(rows: &[CalibrationRow]) {
 
 fn print_consistency(what: &str, c: &Consistency) {
     println!(
-        "chance alone (Fisher's exact test per cell, simulated vs published counts), {what}: {} of {} below p = 0.05; least consistent {} (p = {:.3}; {:.3} after Bonferroni over {} cells)",
+        "chance alone (Fisher's exact test per cell, simulated vs published counts), {what}: {} of {} below p = 0.05 (p = {:.3} for this many); least consistent {} (p = {:.3}; {:.3} after Bonferroni over {} cells)",
         c.below_0_05,
         c.cells,
+        c.p_this_many_below_0_05,
         if c.least_consistent.is_empty() {
             "-"
         } else {

@@ -81,6 +81,48 @@ fn calibrate_prints_rates_beside_the_published_ones() {
     );
     assert!(v["consistency_by_setting"]["cells"].as_u64().unwrap() <= 18);
 
+    // Two seeds: each run as the seed alone, their attempts pooled.
+    let out = hil(&[
+        "kinova",
+        "calibrate",
+        "--trials",
+        "3",
+        "--foods",
+        "carrot",
+        "--json",
+        "--quiet",
+        "--seeds",
+        "2",
+        "--seed",
+        "7",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["seeds"], serde_json::json!([7, 8]));
+    let runs = v["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    for (i, row) in v["pooled"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(row["trials"], 6);
+        let sum: u64 = runs
+            .iter()
+            .map(|r| r["rows"][i]["successes"].as_u64().unwrap())
+            .sum();
+        assert_eq!(row["successes"].as_u64().unwrap(), sum);
+    }
+    let means: Vec<f64> = runs
+        .iter()
+        .map(|r| r["mean_abs_error"].as_f64().unwrap())
+        .collect();
+    let mean = v["mean_abs_error"]["mean"].as_f64().unwrap();
+    assert!((mean - (means[0] + means[1]) / 2.0).abs() < 1e-12);
+    let out = hil(&["kinova", "calibrate", "--seeds", "0"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--seeds"));
+
     let out = hil(&["kinova", "calibrate", "--foods", "apple"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("apple"));

@@ -3,7 +3,9 @@
 //!
 //! - `hil kinova calibrate --trials 30 --json` runs every (food, action)
 //!   pair in randomised simulated attempts and prints the achieved success
-//!   rate beside the published one, with attempts per second.
+//!   rate beside the published one, with attempts per second and each
+//!   cell's p-value against the published counts; `--seeds N` repeats it
+//!   under N master seeds and reports the spread and the pooled attempts.
 //! - `hil demo kinova` runs the paper's real-robot user-study protocol
 //!   (`hil_experiments::user_study`) in simulation: a plate of banana,
 //!   carrot and cantaloupe, N_att = 3, the methods LinUCB, AlwaysQuery and

@@ -369,18 +369,19 @@ fn print_table(rows: &[CalibrationRow]) {
     for chunk in rows.chunks(6) {
         print!("{:<22}", chunk[0].food);
         for r in chunk {
-            print!("{:>18}", cell(r.rate, r.se, r.published));
+            print!("{:>18}", cell(r.rate, r.se, r.published, r.p_value));
         }
         println!();
         for (i, c) in chunk[0].by_setting.iter().enumerate() {
             print!("{:<22}", format!("  {}", c.setting.name()));
             for r in chunk {
                 let c = &r.by_setting[i];
-                print!("{:>18}", cell(c.rate, c.se, c.published));
+                print!("{:>18}", cell(c.rate, c.se, c.published, c.p_value));
             }
             println!();
         }
     }
+    println!("* p < 0.05: a difference from the published rate that chance alone explains poorly");
     let discarded: usize = rows.iter().map(|r| r.discarded).sum();
     println!(
         "{discarded} of {} attempts discarded (fewer than {} tines touched the item, as in the published data set); rates are over the rest",
@@ -418,9 +419,16 @@ fn print_throughput(report: &CalibrationReport) {
     );
 }
 
-fn cell(rate: f64, se: f64, published: Option<f64>) -> String {
+/// `rate±se (published)`, marked `*` when chance alone explains the
+/// difference poorly (Fisher's exact p < 0.05).
+fn cell(rate: f64, se: f64, published: Option<f64>, p_value: Option<f64>) -> String {
     let p = published.map_or("  -  ".into(), |p| format!("{p:.2}"));
-    format!("{rate:.2}±{se:.2} ({p})")
+    let mark = if p_value.is_some_and(|p| p < 0.05) {
+        "*"
+    } else {
+        " "
+    };
+    format!("{rate:.2}±{se:.2} ({p}){mark}")
 }
 
 /// What the results are, printed with them.

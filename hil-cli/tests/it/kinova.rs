@@ -4,13 +4,10 @@
 use crate::common;
 use common::hil;
 
-#[test]
-#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
-fn calibrate_prints_rates_beside_the_published_ones() {
-    let log =
-        std::env::temp_dir().join(format!("hil-kinova-attempts-{}.jsonl", std::process::id()));
-    // Three trials: one per setting, so the published `all` row applies.
-    let out = hil(&[
+/// `hil kinova calibrate` on carrot, 3 trials (one per setting, so the
+/// published `all` row applies), `--json --quiet` and `extra`; its output.
+fn calibrate_carrot_json(extra: &[&str]) -> serde_json::Value {
+    let mut args = vec![
         "kinova",
         "calibrate",
         "--trials",
@@ -19,15 +16,24 @@ fn calibrate_prints_rates_beside_the_published_ones() {
         "carrot",
         "--json",
         "--quiet",
-        "--attempts",
-        log.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let out = hil(&args);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
+fn calibrate_prints_rates_beside_the_published_ones() {
+    let log =
+        std::env::temp_dir().join(format!("hil-kinova-attempts-{}.jsonl", std::process::id()));
+    // Three trials: one per setting, so the published `all` row applies.
+    let v = calibrate_carrot_json(&["--attempts", log.to_str().unwrap()]);
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 6);
     assert_eq!(rows[1]["action"], "VS90");
@@ -82,26 +88,7 @@ fn calibrate_prints_rates_beside_the_published_ones() {
     assert!(v["consistency_by_setting"]["cells"].as_u64().unwrap() <= 18);
 
     // Two seeds: each run as the seed alone, their attempts pooled.
-    let out = hil(&[
-        "kinova",
-        "calibrate",
-        "--trials",
-        "3",
-        "--foods",
-        "carrot",
-        "--json",
-        "--quiet",
-        "--seeds",
-        "2",
-        "--seed",
-        "7",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = calibrate_carrot_json(&["--seeds", "2", "--seed", "7"]);
     assert_eq!(v["seeds"], serde_json::json!([7, 8]));
     let runs = v["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 2);

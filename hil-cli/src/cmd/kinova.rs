@@ -296,6 +296,7 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         "pooled per-setting cells",
         &over.pooled_consistency_by_setting,
     );
+    print!("seed {}'s run: ", seeds[0]);
     print_throughput(first);
     Ok(())
 }

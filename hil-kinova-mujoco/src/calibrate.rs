@@ -406,7 +406,7 @@ pub fn expected_worst_error_of_a_perfect_simulator(rows: &[&CalibrationRow]) -> 
     for row in rows {
         let mut cell = vec![0.0; bins + 1];
         for (e, p) in perfect_simulator_errors(row) {
-            cell[((e * TARGET_GRID).round() as usize).min(bins)] += p;
+            cell[error_bin(e).min(bins)] += p;
         }
         let mut within = 0.0;
         for (b, c) in cdf.iter_mut().enumerate() {
@@ -496,9 +496,8 @@ impl CalibrationTarget {
     /// # Ok::<(), hil_core::HilError>(())
     /// ```
     pub fn chance_a_perfect_simulator_meets(&self, rows: &[&CalibrationRow]) -> f64 {
-        let bin = |e: f64| (e * TARGET_GRID).round() as usize;
-        let worst = bin(self.worst_cell);
-        let budget = bin(self.mean_abs_error * rows.len() as f64);
+        let worst = error_bin(self.worst_cell);
+        let budget = error_bin(self.mean_abs_error * rows.len() as f64);
         // dist[s]: probability that the cells so far are each within
         // `worst` and sum to s bins (sums beyond the budget fail).
         let mut dist = vec![0.0; budget + 1];
@@ -506,7 +505,7 @@ impl CalibrationTarget {
         for row in rows {
             let mut cell = vec![0.0; worst + 1];
             for (e, p) in perfect_simulator_errors(row) {
-                if let Some(c) = cell.get_mut(bin(e)) {
+                if let Some(c) = cell.get_mut(error_bin(e)) {
                     *c += p;
                 }
             }
@@ -524,6 +523,11 @@ impl CalibrationTarget {
 
 /// Bins per unit of error in [`CalibrationTarget::chance_a_perfect_simulator_meets`].
 pub const TARGET_GRID: f64 = 3600.0;
+/// The bin of an error on the 1/[`TARGET_GRID`] grid.
+fn error_bin(e: f64) -> usize {
+    (e * TARGET_GRID).round() as usize
+}
+
 /// Rounding allowance when comparing an error with a target.
 const TARGET_TOLERANCE: f64 = 1e-9;
 
@@ -563,16 +567,14 @@ pub fn binomial_se(successes: usize, trials: usize) -> f64 {
 /// Fisher's exact two-sided p-value that the counted attempts of `t` and
 /// the published attempts behind `published` (one rate per setting, each
 /// over [`PUBLISHED_TRIALS_PER_SETTING`] trials) share one success rate;
-/// `None` when no attempt counted.
+/// `None` when no attempt counted or nothing was published (the test has
+/// no sample then).
 fn consistency_p(t: &Tally, published: &[f64]) -> Option<f64> {
     let n = PUBLISHED_TRIALS_PER_SETTING as f64;
     // A published rate is a count over its trials (0.4 = 4 of 10).
     let successes: u64 = published.iter().map(|p| (p * n).round() as u64).sum();
     let trials = (PUBLISHED_TRIALS_PER_SETTING * published.len()) as u64;
     let counted = (t.trials - t.discarded) as u64;
-    if published.is_empty() {
-        return None;
-    }
     fisher_exact(
         t.successes as u64,
         counted,
@@ -582,6 +584,13 @@ fn consistency_p(t: &Tally, published: &[f64]) -> Option<f64> {
     )
     .ok()
     .map(|r| r.p_value)
+}
+
+/// [`consistency_p`] of a row's tally against the published rates of its
+/// setting cells.
+fn row_p_value(t: &Tally, cells: &[SettingCell]) -> Option<f64> {
+    let published: Vec<f64> = cells.iter().filter_map(|c| c.published).collect();
+    consistency_p(t, &published)
 }
 
 /// Whether a table's differences from the published one exceed what the
@@ -813,7 +822,7 @@ fn pool_rows(runs: &[CalibrationReport]) -> Vec<CalibrationRow> {
                     });
                     let t = Tally::of(n, d, s);
                     SettingCell {
-                        p_value: consistency_p(&t, &cell.published.into_iter().collect::<Vec<_>>()),
+                        p_value: consistency_p(&t, cell.published.as_slice()),
                         trials: t.trials,
                         discarded: t.discarded,
                         successes: t.successes,
@@ -825,9 +834,8 @@ fn pool_rows(runs: &[CalibrationReport]) -> Vec<CalibrationRow> {
                 .collect();
             let (n, d, s) = sum(&|r| (r.rows[i].trials, r.rows[i].discarded, r.rows[i].successes));
             let t = Tally::of(n, d, s);
-            let published: Vec<f64> = by_setting.iter().filter_map(|c| c.published).collect();
             CalibrationRow {
-                p_value: consistency_p(&t, &published),
+                p_value: row_p_value(&t, &by_setting),
                 trials: t.trials,
                 discarded: t.discarded,
                 successes: t.successes,
@@ -886,12 +894,8 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                         / t.trials.max(1) as f64,
                 )
             };
-            let published_per_setting: Vec<f64> = by_setting
-                .iter()
-                .map(|c| food.published_rates_in(c.setting)[a])
-                .collect();
             rows.push(CalibrationRow {
-                p_value: consistency_p(&t, &published_per_setting),
+                p_value: row_p_value(&t, &by_setting),
                 food: food.name().into(),
                 action: action.name.into(),
                 trials: t.trials,

@@ -1,6 +1,7 @@
 //! Splitting a dataset's foods into pretraining, validation and test sets.
 
 use hil_core::{HilError, Result};
+use hil_paper::simulation;
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::FoodDataset;
@@ -26,35 +27,15 @@ pub struct FoodSplit {
     pub test: Vec<String>,
 }
 
-/// The paper's validation foods.
-pub const PAPER_VALIDATION: [&str; 2] = ["cantaloupe", "grape"];
-/// The paper's test foods.
-pub const PAPER_TEST: [&str; 2] = ["banana", "carrot"];
-/// The paper's twelve pretraining foods.
-pub const PAPER_PRETRAIN: [&str; 12] = [
-    "apple",
-    "bell_pepper",
-    "broccoli",
-    "cauliflower",
-    "celery",
-    "cherry_tomato",
-    "honeydew",
-    "kiwi",
-    "strawberry",
-    "lettuce",
-    "spinach",
-    "kale",
-];
-
 impl FoodSplit {
-    /// The paper's split: validation cantaloupe, grape; test banana, carrot;
-    /// the other twelve foods pretrain.
+    /// The paper's split ([`hil_paper::simulation`]): validation cantaloupe,
+    /// grape; test banana, carrot; the other twelve foods pretrain.
     pub fn paper() -> Self {
         let v = |s: &[&str]| s.iter().map(|x| x.to_string()).collect();
         Self {
-            pretrain: v(&PAPER_PRETRAIN),
-            validation: v(&PAPER_VALIDATION),
-            test: v(&PAPER_TEST),
+            pretrain: v(&simulation::PRETRAIN_FOODS),
+            validation: v(&simulation::VALIDATION_FOODS),
+            test: v(&simulation::TEST_FOODS),
         }
     }
 

@@ -51,6 +51,7 @@
 //! ```
 
 use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadModel};
+use hil_paper::methods::{ALWAYS_QUERY, LINUCB};
 use hil_workload::models::{FittedModel, GrangerModel, GrangerVariant, ModelSpec, Provenance};
 
 use crate::testbed::ProtocolSettings;
@@ -257,9 +258,9 @@ pub fn targets(model: &str) -> Result<Targets> {
             )
         })
     };
-    let (dwl_none, _) = figure("LinUCB", "delta_wl")?;
-    let (dwl_aq, _) = figure("AlwaysQuery", "delta_wl")?;
-    let (t_conv, t_conv_std) = figure("AlwaysQuery", "t_conv")?;
+    let (dwl_none, _) = figure(LINUCB, "delta_wl")?;
+    let (dwl_aq, _) = figure(ALWAYS_QUERY, "delta_wl")?;
+    let (t_conv, t_conv_std) = figure(ALWAYS_QUERY, "t_conv")?;
     let lengths = implied_lengths(t_conv, t_conv_std, items, settings.n_seeds)?;
     Ok(Targets {
         model: model.to_string(),

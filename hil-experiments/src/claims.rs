@@ -13,6 +13,7 @@
 use std::fmt::Write as _;
 
 use hil_core::Result;
+use hil_paper::methods::{ALWAYS_QUERY, LINUCB, LINUCB_EXPDECAY, LINUCB_QG};
 
 use crate::calibrate::End;
 use crate::published;
@@ -93,37 +94,37 @@ pub fn claims_markdown(res: &ProtocolResults) -> Result<String> {
         for (claim, a, b, f, greater) in [
             (
                 "QG r_task > LinUCB",
-                "LinUCB-QG",
-                "LinUCB",
+                LINUCB_QG,
+                LINUCB,
                 r_task as fn(&_) -> Stat,
                 true,
             ),
             (
                 "QG r_task > ExpDecay",
-                "LinUCB-QG",
-                "LinUCB-ExpDecay",
+                LINUCB_QG,
+                LINUCB_EXPDECAY,
                 r_task,
                 true,
             ),
-            ("QG M_wt vs LinUCB", "LinUCB-QG", "LinUCB", m_wt, true),
+            ("QG M_wt vs LinUCB", LINUCB_QG, LINUCB, m_wt, true),
             (
                 "QG M_wt vs AlwaysQuery",
-                "LinUCB-QG",
-                "AlwaysQuery",
+                LINUCB_QG,
+                ALWAYS_QUERY,
                 m_wt,
                 true,
             ),
             (
                 "QG M_wt vs ExpDecay",
-                "LinUCB-QG",
-                "LinUCB-ExpDecay",
+                LINUCB_QG,
+                LINUCB_EXPDECAY,
                 m_wt,
                 true,
             ),
             (
                 "QG ΔWL < AlwaysQuery",
-                "LinUCB-QG",
-                "AlwaysQuery",
+                LINUCB_QG,
+                ALWAYS_QUERY,
                 |t| t.delta_wl,
                 false,
             ),
@@ -156,8 +157,8 @@ pub fn claims_markdown(res: &ProtocolResults) -> Result<String> {
         let name = |base: &str| end.model_name(base);
         for (lo, hi) in [("f2_sim", "f12_sim"), ("f12_sim", "f1_sim")] {
             if let (Some(a), Some(b)) = (
-                get(&name(hi), "LinUCB-QG", f_q),
-                get(&name(lo), "LinUCB-QG", f_q),
+                get(&name(hi), LINUCB_QG, f_q),
+                get(&name(lo), LINUCB_QG, f_q),
             ) {
                 let _ = writeln!(
                     o,
@@ -257,7 +258,7 @@ pub fn claims_markdown(res: &ProtocolResults) -> Result<String> {
         "\n### The model-only rows in the protocol (w_task = 0.7)\n\nLinUCB and AlwaysQuery decide without the workload model, so their ΔWL describes the model on the schedules the protocol produces. The calibration meets the paper's on the schedules the paper's rows imply; here hil's own schedules (its t_conv) differ, and the gap is shown.\n\n| model | method | ΔWL here (± SE) | ΔWL paper | t_conv here (± SE) | t_conv paper |\n|---|---|---|---|---|---|"
     );
     for m in &res.models {
-        for method in ["LinUCB", "AlwaysQuery"] {
+        for method in [LINUCB, ALWAYS_QUERY] {
             if let Some(r) = res.row(m, w, method) {
                 let p = published.convergence(s.paper_name(m), w, method);
                 let pf = |f: &str| {

@@ -14,18 +14,18 @@ use std::collections::BTreeMap;
 
 use hil_core::config::PolicyConfig;
 use hil_core::{HilError, Result};
+use hil_paper::methods::PaperMethod;
 use serde::{Deserialize, Deserializer, Serialize};
 
-/// The UCB confidence weight α of the paper's methods (the paper does not
-/// state it; ours, for the testbed and the user study alike).
-pub const PAPER_ALPHA: f64 = 0.5;
-
-/// The paper's policy table for `ty`: α = [`PAPER_ALPHA`], λ = 1, pretrained
+/// The paper's policy table for `ty`: α = [`hil_paper::methods::ALPHA`], λ = 1, pretrained
 /// on the environment's offline data, plus `extra` parameters.
 pub fn paper_policy(ty: &str, extra: &[(&str, f64)]) -> toml::Table {
     let mut t = toml::Table::new();
     t.insert("type".into(), toml::Value::String(ty.into()));
-    t.insert("alpha".into(), toml::Value::Float(PAPER_ALPHA));
+    t.insert(
+        "alpha".into(),
+        toml::Value::Float(hil_paper::methods::ALPHA),
+    );
     t.insert("lambda".into(), toml::Value::Float(1.0));
     t.insert("pretrain".into(), toml::Value::Boolean(true));
     for (k, v) in extra {
@@ -76,6 +76,34 @@ impl Method {
             label: label.into(),
             policy,
             tune: BTreeMap::new(),
+        }
+    }
+
+    /// The paper's method `m` ([`hil_paper::methods`]): its label, its
+    /// policy type as [`paper_policy`] configures it, and hil's grid for its
+    /// tuned hyperparameter.
+    ///
+    /// ```
+    /// use hil_experiments::method::Method;
+    /// use hil_paper::methods::PaperMethod;
+    /// let qg = Method::paper(PaperMethod::LinUcbQg);
+    /// assert_eq!(qg.label, "LinUCB-QG");
+    /// assert_eq!(qg.grid().len(), 8);
+    /// ```
+    pub fn paper(m: PaperMethod) -> Self {
+        match m.tuned() {
+            None => Self::new(m.label(), paper_policy(m.policy_type(), &[])),
+            Some((name, grid)) => {
+                // The value the method's own table holds; every grid point
+                // replaces it. Kept as protocol files have always written
+                // it (results.json echoes the settings).
+                let base = match m {
+                    PaperMethod::LinUcbQg => 1.0,
+                    _ => grid[0],
+                };
+                Self::new(m.label(), paper_policy(m.policy_type(), &[(name, base)]))
+                    .tuned(name, grid)
+            }
         }
     }
 

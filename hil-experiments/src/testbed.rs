@@ -48,6 +48,8 @@ use hil_core::{
 };
 use hil_envs::env::{PretrainReward, pretraining_data};
 use hil_envs::{FoodDataset, FoodSplit};
+use hil_paper::methods::{ALWAYS_QUERY, LINUCB_EXPDECAY, LINUCB_QG, PaperMethod};
+use hil_paper::simulation;
 use rayon::prelude::*;
 
 use crate::calibrate::End;
@@ -55,7 +57,7 @@ use crate::components::{
     ConfiguredChannel, ConfiguredEnvironment, DatasetReplay, EpisodeSpec, PerfectExpertChannel,
     SharedChannelFactory, SharedEnvironmentFactory, check_matches_task,
 };
-use crate::method::{GridPoint, Method, paper_policy};
+use crate::method::{GridPoint, Method};
 use crate::results::Reproduction;
 use serde::{Deserialize, Serialize};
 
@@ -156,12 +158,12 @@ impl ProtocolSettings {
     /// ours (the paper does not list them).
     pub fn paper() -> Self {
         let cross = |decide: &str| CrossSetting {
-            method: "LinUCB-QG".into(),
+            method: LINUCB_QG.into(),
             decide: decide.into(),
             score: "f2_sim".into(),
         };
         let cross_steep = |decide: &str| CrossSetting {
-            method: "LinUCB-QG".into(),
+            method: LINUCB_QG.into(),
             decide: End::Steep.model_name(decide),
             score: End::Steep.model_name("f2_sim"),
         };
@@ -176,36 +178,26 @@ impl ProtocolSettings {
             session: SessionSettings::default(),
             items_per_episode: 5,
             seed: 0,
-            n_seeds: 3,
+            n_seeds: simulation::SEEDS,
             many_seeds: 30,
-            n_policy_seeds: 5,
-            w_tasks: (2..=9).map(|k| k as f64 / 10.0).collect(),
-            methods: vec![
-                Method::new("LinUCB", paper_policy("linucb", &[])),
-                Method::new("AlwaysQuery", paper_policy("always_query", &[])),
-                Method::new(
-                    "LinUCB-ExpDecay",
-                    paper_policy("linucb_exp_decay", &[("c", 0.0)]),
-                )
-                .tuned("c", &[0.0, 0.1, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0]),
-                Method::new("LinUCB-QG", paper_policy("linucb_qg", &[("w", 1.0)]))
-                    .tuned("w", &[0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0]),
-            ],
+            n_policy_seeds: simulation::EXPDECAY_POLICY_SEEDS,
+            w_tasks: simulation::W_TASKS.to_vec(),
+            methods: PaperMethod::ALL.into_iter().map(Method::paper).collect(),
             cross: vec![
                 cross("f1_sim"),
                 cross("f12_sim"),
                 cross_steep("f1_sim"),
                 cross_steep("f12_sim"),
             ],
-            cross_w_task: 0.4,
+            cross_w_task: simulation::CROSS_W_TASK,
             figures: FigureSettings {
                 model: "f2_sim".into(),
-                w_task: 0.7,
-                rollout: "LinUCB-QG".into(),
+                w_task: simulation::FIGURE_W_TASK,
+                rollout: LINUCB_QG.into(),
                 workload: vec![
-                    "AlwaysQuery".into(),
-                    "LinUCB-ExpDecay".into(),
-                    "LinUCB-QG".into(),
+                    ALWAYS_QUERY.into(),
+                    LINUCB_EXPDECAY.into(),
+                    LINUCB_QG.into(),
                 ],
             },
             channel: None,

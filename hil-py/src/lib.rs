@@ -41,7 +41,7 @@ fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("KINOVA", cfg!(feature = "kinova"))?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The UCB weight α of the paper's methods (hil's choice; the paper does not state it).
-    m.add("PAPER_ALPHA", hil_experiments::method::PAPER_ALPHA)?;
+    m.add("PAPER_ALPHA", hil_paper::methods::ALPHA)?;
     errors::register(m)?;
     components::register(m)?;
     registry::register_module(m)?;

@@ -17,22 +17,12 @@ use std::ops::Range;
 
 use hil_core::Result;
 use hil_core::metrics::Stat;
+use hil_paper::workload_study::{D1_BELOW_D2_P, D1_WORKLOAD, D2_WORKLOAD};
 use serde::{Deserialize, Serialize};
 
 use crate::bundle::StudySummary;
 use crate::datasets::DatasetId;
 use crate::synth::SynthConfig;
-
-/// The paper's D1 mean querying workload.
-pub const PAPER_D1_MEAN: f64 = 0.36;
-/// The paper's D1 standard deviation.
-pub const PAPER_D1_SD: f64 = 0.29;
-/// The paper's D2 mean querying workload.
-pub const PAPER_D2_MEAN: f64 = 0.40;
-/// The paper's D2 standard deviation.
-pub const PAPER_D2_SD: f64 = 0.28;
-/// The paper's one-sided Mann-Whitney p (D1 < D2).
-pub const PAPER_P: f64 = 5.4e-5;
 
 /// One generated study's headline figures.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -129,14 +119,15 @@ impl SeedSpread {
             "over {} generator seeds (mean over seeds, its standard error, and the sd of one draw):\n",
             self.draws.len()
         );
-        s.push_str(&row("D1 mean", &self.d1_mean, PAPER_D1_MEAN));
-        s.push_str(&row("D1 sd", &self.d1_sd, PAPER_D1_SD));
-        s.push_str(&row("D2 mean", &self.d2_mean, PAPER_D2_MEAN));
-        s.push_str(&row("D2 sd", &self.d2_sd, PAPER_D2_SD));
+        s.push_str(&row("D1 mean", &self.d1_mean, D1_WORKLOAD.mean));
+        s.push_str(&row("D1 sd", &self.d1_sd, D1_WORKLOAD.sd));
+        s.push_str(&row("D2 mean", &self.d2_mean, D2_WORKLOAD.mean));
+        s.push_str(&row("D2 sd", &self.d2_sd, D2_WORKLOAD.sd));
         s.push_str(&format!(
-            "Mann-Whitney p (D1 < D2): median {:.2e}, below 0.05 in {:.0} % of seeds   paper {PAPER_P:e}\n",
+            "Mann-Whitney p (D1 < D2): median {:.2e}, below 0.05 in {:.0} % of seeds   paper {:e}\n",
             self.p_median,
-            100.0 * self.p_below_005
+            100.0 * self.p_below_005,
+            D1_BELOW_D2_P
         ));
         if let Some(d) = self.draws.first() {
             s.push_str(&format!("pairs per draw: D1 {}, D2 {}\n", d.d1.0, d.d2.0));
@@ -164,15 +155,15 @@ pub fn centre(
     let mut spread = SeedSpread::over(&c, seeds.clone())?;
     let round = |x: f64| (x * 1e4).round() / 1e4;
     for _ in 0..max_rounds {
-        let g1 = PAPER_D1_MEAN - spread.d1_mean.mean;
-        let g2 = PAPER_D2_MEAN - spread.d2_mean.mean;
-        let v1 = PAPER_D1_SD.powi(2) - spread.d1_sd.mean.powi(2);
-        let v2 = PAPER_D2_SD.powi(2) - spread.d2_sd.mean.powi(2);
+        let g1 = D1_WORKLOAD.mean - spread.d1_mean.mean;
+        let g2 = D2_WORKLOAD.mean - spread.d2_mean.mean;
+        let v1 = D1_WORKLOAD.sd.powi(2) - spread.d1_sd.mean.powi(2);
+        let v2 = D2_WORKLOAD.sd.powi(2) - spread.d2_sd.mean.powi(2);
         if [
             g1,
             g2,
-            PAPER_D1_SD - spread.d1_sd.mean,
-            PAPER_D2_SD - spread.d2_sd.mean,
+            D1_WORKLOAD.sd - spread.d1_sd.mean,
+            D2_WORKLOAD.sd - spread.d2_sd.mean,
         ]
         .iter()
         .all(|g| g.abs() <= tolerance)

@@ -2,7 +2,8 @@
 //! expectation, not in one lucky draw: over generator seeds 0..100 the
 //! mean D1 and D2 workloads are within 0.01 of the published 0.36 and 0.40.
 
-use hil_workload::seeds::{PAPER_D1_MEAN, PAPER_D2_MEAN, SeedSpread};
+use hil_paper::workload_study::{D1_WORKLOAD, D2_WORKLOAD};
+use hil_workload::seeds::SeedSpread;
 use hil_workload::synth::SynthConfig;
 
 #[test]
@@ -10,12 +11,12 @@ fn the_generator_is_centred_over_100_seeds() {
     let s = SeedSpread::over(&SynthConfig::default(), 0..100).unwrap();
     assert_eq!(s.draws.len(), 100);
     assert!(
-        (s.d1_mean.mean - PAPER_D1_MEAN).abs() < 0.01,
+        (s.d1_mean.mean - D1_WORKLOAD.mean).abs() < 0.01,
         "{}",
         s.to_text()
     );
     assert!(
-        (s.d2_mean.mean - PAPER_D2_MEAN).abs() < 0.01,
+        (s.d2_mean.mean - D2_WORKLOAD.mean).abs() < 0.01,
         "{}",
         s.to_text()
     );

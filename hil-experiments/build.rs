@@ -1,16 +1,5 @@
-//! Embeds an rpath to the MuJoCo shared library (`MUJOCO_DYNAMIC_LINK_DIR`
-//! from `.cargo/config.toml`), so this crate's tests and doctests, which link
-//! hil-kinova-mujoco for the user study's MuJoCo scene, start without
-//! `LD_LIBRARY_PATH`. Link arguments of a library's build script do not
-//! reach other packages' binaries, hence a build script here too.
+//! Embeds the MuJoCo rpath in this package's artefacts (see `hil-build`).
 
 fn main() {
-    println!("cargo::rerun-if-env-changed=MUJOCO_DYNAMIC_LINK_DIR");
-    // Without the `physics` feature nothing links MuJoCo.
-    if std::env::var_os("CARGO_FEATURE_PHYSICS").is_none() {
-        return;
-    }
-    if let Ok(dir) = std::env::var("MUJOCO_DYNAMIC_LINK_DIR") {
-        println!("cargo::rustc-link-arg=-Wl,-rpath,{dir}");
-    }
+    hil_build::mujoco_rpath();
 }

@@ -128,6 +128,21 @@ impl Generated {
 }
 
 impl SyntheticFoods {
+    /// A small generator for tests and examples: the default foods and
+    /// rates at 224 features and 3 images per setting.
+    ///
+    /// ```
+    /// let ds = hil_envs::generate::SyntheticFoods::small().generate().unwrap().dataset;
+    /// assert_eq!(ds.context_dim, 224);
+    /// ```
+    pub fn small() -> Self {
+        Self {
+            dim: 224,
+            images_per_setting: 3,
+            ..Self::default()
+        }
+    }
+
     /// Checks the parameters.
     pub fn validate(&self) -> Result<()> {
         let finite_nonneg = |name: &str, v: f64| {

@@ -1,7 +1,7 @@
 //! Runs one attempt of every action on every food and prints the reports.
 //!
 //! `cargo run -p hil-kinova-mujoco --example attempt`
-use hil_kinova_mujoco::{ACTIONS, FoodKind, FoodModel, PerceivedTarget, Placement, Simulator};
+use hil_kinova_mujoco::{ACTIONS, FoodKind, FoodModel, Placement, Simulator};
 use rand::SeedableRng;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -18,11 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }];
             let poses = sim.stage(&items, None, kind)?;
             let t = poses[0];
-            let perceived = PerceivedTarget {
-                centre: t.centre,
-                yaw: t.yaw,
-                half_height: t.half_extents[2],
-            };
+            let perceived = t.exact_target();
             let r = sim.execute(a, &perceived, None)?;
             println!(
                 "{} {} success={} pitch={:.3} gamma={:.3} roll={:.3} handle={:.3} stop={:?} peak={:.1} tines={:?} h={:.3}",

@@ -4,7 +4,7 @@
 //! along the tines during the hold.
 //!
 //! `cargo run --release -p hil-kinova-mujoco --example hold -- [trials] [hold_s] [free_step_s]`
-use hil_kinova_mujoco::{ACTIONS, FoodKind, FoodModel, PerceivedTarget, Placement, Simulator};
+use hil_kinova_mujoco::{ACTIONS, FoodKind, FoodModel, Placement, Simulator};
 use rand::SeedableRng;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -30,11 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }];
                 let poses = sim.stage(&items, None, kind)?;
                 let p = poses[0];
-                let perceived = PerceivedTarget {
-                    centre: p.centre,
-                    yaw: p.yaw,
-                    half_height: p.half_extents[2],
-                };
+                let perceived = p.exact_target();
                 let r = sim.execute(a, &perceived, None)?;
                 steps += r.steps;
                 if r.lifted_height > 0.03 {

@@ -84,6 +84,18 @@ pub struct TruePose {
     pub on_leaf: bool,
 }
 
+impl TruePose {
+    /// The target as a perfect perception would report it: the true
+    /// centre, yaw and half height.
+    pub fn exact_target(&self) -> PerceivedTarget {
+        PerceivedTarget {
+            centre: self.centre,
+            yaw: self.yaw,
+            half_height: self.half_extents[2],
+        }
+    }
+}
+
 /// What the controller is told about the target: a noisy perceived pose.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PerceivedTarget {

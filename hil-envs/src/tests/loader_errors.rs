@@ -10,14 +10,7 @@ use crate::generate::SyntheticFoods;
 use crate::npy::{NpyArray, read_npy, write_npy};
 
 fn small() -> FoodDataset {
-    SyntheticFoods {
-        dim: 224,
-        images_per_setting: 3,
-        ..SyntheticFoods::default()
-    }
-    .generate()
-    .unwrap()
-    .dataset
+    SyntheticFoods::small().generate().unwrap().dataset
 }
 
 fn tmp(name: &str) -> PathBuf {

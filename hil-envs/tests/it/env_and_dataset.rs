@@ -10,16 +10,7 @@ use hil_envs::generate::SyntheticFoods;
 use hil_envs::{DatasetReplayEnv, FoodSplit, OutcomeMode};
 
 fn small() -> Arc<FoodDataset> {
-    Arc::new(
-        SyntheticFoods {
-            dim: 224,
-            images_per_setting: 3,
-            ..SyntheticFoods::default()
-        }
-        .generate()
-        .unwrap()
-        .dataset,
-    )
+    Arc::new(SyntheticFoods::small().generate().unwrap().dataset)
 }
 
 fn tmp(name: &str) -> PathBuf {

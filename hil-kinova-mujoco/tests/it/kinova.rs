@@ -13,10 +13,12 @@ use hil_core::{
 };
 use hil_kinova_mujoco::{
     ACTIONS, FoodKind, FoodModel, KinovaError, KinovaFeedingConfig, KinovaFeedingEnv, MjcfSource,
-    PerceivedTarget, Placement, Simulator,
+    Placement, Simulator,
 };
 use nalgebra::Vector3;
 use rand::SeedableRng;
+
+use crate::common::assert_reached;
 
 fn small_env() -> KinovaFeedingEnv {
     KinovaFeedingEnv::new(KinovaFeedingConfig {
@@ -83,24 +85,9 @@ fn every_action_reaches_its_commanded_pitch_and_roll() {
             yaw,
         }];
         let pose = sim.stage(&items, None, FoodKind::Cantaloupe).unwrap()[0];
-        let perceived = PerceivedTarget {
-            centre: pose.centre,
-            yaw: pose.yaw,
-            half_height: pose.half_extents[2],
-        };
-        let r = sim.execute(action, &perceived, None).unwrap();
-        assert!(
-            (r.reached_pitch - action.pitch).abs() < 0.03,
-            "{}: pitch {}",
-            action.name,
-            r.reached_pitch
-        );
-        assert!(
-            (r.reached_roll - action.roll).abs() < 0.05,
-            "{}: roll {}",
-            action.name,
-            r.reached_roll
-        );
+        let r = sim.execute(action, &pose.exact_target(), None).unwrap();
+        assert_reached(action, "pitch", r.reached_pitch, action.pitch, 0.03);
+        assert_reached(action, "roll", r.reached_roll, action.roll, 0.05);
         assert!(r.tines.touched >= 2, "{}: tines {:?}", action.name, r.tines);
     }
 }

@@ -4,10 +4,10 @@
 //! handle's orientation.
 
 use hil_kinova_mujoco::{
-    ACTIONS, Action, FoodKind, FoodModel, KinovaError, PUBLISHED_HOLD, PerceivedTarget, Placement,
-    RollBy, Simulator, StopReason,
+    ACTIONS, Action, FoodKind, KinovaError, PUBLISHED_HOLD, RollBy, Simulator, StopReason,
 };
-use rand::SeedableRng;
+
+use crate::common::{assert_reached, attempt_at};
 
 /// Stages one item of `kind` at the plate centre (seeded) and executes `action`.
 fn attempt(
@@ -16,20 +16,14 @@ fn attempt(
     action: &Action,
     seed: u64,
 ) -> hil_kinova_mujoco::AttemptReport {
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let props = FoodModel::default_for(kind).sample(&mut rng);
-    let items = vec![Placement {
-        props,
-        xy: [0.005, -0.005],
-        yaw: -1.2 + 0.45 * seed as f64,
-    }];
-    let pose = sim.stage(&items, None, kind).unwrap()[0];
-    let perceived = PerceivedTarget {
-        centre: pose.centre,
-        yaw: pose.yaw,
-        half_height: pose.half_extents[2],
-    };
-    sim.execute(action, &perceived, None).unwrap()
+    attempt_at(
+        sim,
+        kind,
+        action,
+        seed,
+        [0.005, -0.005],
+        -1.2 + 0.45 * seed as f64,
+    )
 }
 
 #[test]
@@ -79,19 +73,9 @@ fn each_action_rolls_by_the_forks_gamma_while_the_arm_holds_the_handle() {
     let mut sim = Simulator::new().unwrap();
     for (i, action) in ACTIONS.iter().enumerate() {
         let r = attempt(&mut sim, FoodKind::Cantaloupe, action, i as u64);
-        assert!(
-            (r.reached_pitch - action.pitch).abs() < 0.03,
-            "{}: β {}",
-            action.name,
-            r.reached_pitch
-        );
+        assert_reached(action, "β", r.reached_pitch, action.pitch, 0.03);
         // The roll is made by the fork's γ joint ...
-        assert!(
-            (r.reached_gamma - action.roll).abs() < 0.03,
-            "{}: γ {}",
-            action.name,
-            r.reached_gamma
-        );
+        assert_reached(action, "γ", r.reached_gamma, action.roll, 0.03);
         // ... while the arm keeps the handle (fork base) aligned with the
         // major axis for every action ...
         assert!(
@@ -102,12 +86,7 @@ fn each_action_rolls_by_the_forks_gamma_while_the_arm_holds_the_handle() {
         );
         // ... and the tine row ends up at the commanded angle to the major
         // axis (its horizontal part; at β ≠ 0 the rolled row also tilts).
-        assert!(
-            (r.reached_roll - action.roll).abs() < 0.08,
-            "{}: row at {} rad",
-            action.name,
-            r.reached_roll
-        );
+        assert_reached(action, "row angle", r.reached_roll, action.roll, 0.08);
     }
 }
 

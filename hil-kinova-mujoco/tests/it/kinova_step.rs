@@ -2,27 +2,20 @@
 //! the pre-pose, the hold) gives the outcomes of the model's own 1 ms step,
 //! and MuJoCo's warnings stay out of the working directory.
 
+use crate::common::attempt_at;
 use hil_kinova_mujoco::{
-    ACTIONS, AttemptReport, FREE_DT, FoodKind, FoodModel, KinovaError, MAX_DT, PerceivedTarget,
-    Placement, REF_DT, Simulator,
+    ACTIONS, AttemptReport, FREE_DT, FoodKind, KinovaError, MAX_DT, REF_DT, Simulator,
 };
-use rand::SeedableRng;
 
 fn attempt(sim: &mut Simulator, kind: FoodKind, action: usize, seed: u64) -> AttemptReport {
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let props = FoodModel::default_for(kind).sample(&mut rng);
-    let items = vec![Placement {
-        props,
-        xy: [0.0, 0.0],
-        yaw: 0.4 * seed as f64,
-    }];
-    let pose = sim.stage(&items, None, kind).unwrap()[0];
-    let perceived = PerceivedTarget {
-        centre: pose.centre,
-        yaw: pose.yaw,
-        half_height: pose.half_extents[2],
-    };
-    sim.execute(&ACTIONS[action], &perceived, None).unwrap()
+    attempt_at(
+        sim,
+        kind,
+        &ACTIONS[action],
+        seed,
+        [0.0, 0.0],
+        0.4 * seed as f64,
+    )
 }
 
 #[test]

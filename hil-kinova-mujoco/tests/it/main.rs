@@ -4,6 +4,7 @@
 //! --features physics` (scripts/test turns it on).
 #![cfg(feature = "physics")]
 
+mod common;
 mod kinova;
 mod kinova_hold_roll;
 mod kinova_pretrain;

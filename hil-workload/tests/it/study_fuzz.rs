@@ -41,13 +41,7 @@ fn assert_located(e: &HilError) -> Result<(), TestCaseError> {
 }
 
 fn without_lines(s: &Study) -> Vec<StudyRecord> {
-    s.records()
-        .iter()
-        .map(|r| StudyRecord {
-            line: 0,
-            ..r.clone()
-        })
-        .collect()
+    s.records().iter().map(StudyRecord::without_line).collect()
 }
 
 fn check(bytes: &[u8]) -> Result<(), TestCaseError> {

@@ -3,11 +3,12 @@
 use std::path::Path;
 use std::sync::Arc;
 
+use hil_stats::mean_std;
 use serde::{Deserialize, Serialize};
 
 use crate::config::{BuildContext, ExperimentConfig};
 use crate::error::Result;
-use crate::metrics::{EpisodeMetrics, mean_std};
+use crate::metrics::EpisodeMetrics;
 use crate::session::{EpisodeReport, Session, SessionObserver, SessionSettings, splitmix};
 use crate::{Environment, Policy, QueryChannel, WorkloadModel};
 

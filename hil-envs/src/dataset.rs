@@ -81,14 +81,17 @@ impl Food {
     /// Mean of s(x, a) over the food's images, per action.
     pub fn mean_success(&self) -> Vec<f64> {
         let n_a = self.images.first().map_or(0, |i| i.success.len());
-        let mut m = vec![0.0; n_a];
-        for img in &self.images {
-            for (acc, p) in m.iter_mut().zip(&img.success) {
-                *acc += p;
-            }
-        }
-        m.iter()
-            .map(|v| v / self.images.len().max(1) as f64)
+        (0..n_a)
+            .map(|a| {
+                // An image without this action (only in a dataset built
+                // unchecked) counts 0, as in a sum over the images.
+                let column: Vec<f64> = self
+                    .images
+                    .iter()
+                    .map(|i| i.success.get(a).copied().unwrap_or(0.0))
+                    .collect();
+                hil_stats::mean(&column)
+            })
             .collect()
     }
 }

@@ -220,9 +220,8 @@ impl SyntheticFoods {
                 }
                 probs.extend(block.into_iter().map(|p| (s, p)));
             }
-            let n = probs.len() as f64;
             let mean: Vec<f64> = (0..n_a)
-                .map(|a| probs.iter().map(|(_, p)| p[a]).sum::<f64>() / n)
+                .map(|a| hil_stats::mean(&probs.iter().map(|(_, p)| p[a]).collect::<Vec<_>>()))
                 .collect();
             let mut images = Vec::with_capacity(probs.len());
             for (s, p) in probs {
@@ -290,7 +289,7 @@ fn centred_perturbation(rng: &mut ChaCha8Rng, n: usize, r: f64, spread: f64) -> 
     if n < 2 {
         return vec![0.0; n];
     }
-    let m = e.iter().sum::<f64>() / n as f64;
+    let m = hil_stats::mean(&e);
     e.iter_mut().for_each(|v| *v -= m);
     let mut scale = spread;
     for v in &e {

@@ -196,7 +196,7 @@ pub fn implied_lengths(mean: f64, std: f64, items: usize, seeds: usize) -> Resul
     }
     let check = |ts: &[u64]| {
         let per: Vec<f64> = ts.iter().map(|&t| t as f64 / items_f).collect();
-        let (m, s) = hil_core::metrics::mean_std(&per);
+        let (m, s) = hil_stats::mean_std(&per);
         (m - mean).abs() < 5e-4 && (s - std).abs() < 5e-4
     };
     walk(&mut current, total, seeds, lo, &mut found, &check);

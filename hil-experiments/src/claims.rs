@@ -14,10 +14,11 @@ use std::fmt::Write as _;
 
 use hil_core::Result;
 use hil_paper::methods::{ALWAYS_QUERY, LINUCB, LINUCB_EXPDECAY, LINUCB_QG};
+use hil_stats::Stat;
 
 use crate::calibrate::End;
 use crate::published;
-use crate::results::{ProtocolResults, Stat};
+use crate::results::ProtocolResults;
 
 /// The verdict on one comparison.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -286,7 +287,12 @@ mod tests {
     use super::*;
 
     fn stat(mean: f64, se: f64) -> Stat {
-        Stat { mean, std: 0.0, se }
+        Stat {
+            mean,
+            std: 0.0,
+            se,
+            n: 2,
+        }
     }
 
     #[test]

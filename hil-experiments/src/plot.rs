@@ -353,7 +353,8 @@ const METHOD_COLOURS: [&str; 6] = [
 /// hyperparameter buys whichever one validation picks.
 ///
 /// ```
-/// use hil_experiments::results::{FrontierPoint, Stat};
+/// use hil_experiments::results::FrontierPoint;
+/// use hil_stats::Stat;
 /// let p = |v: f64, r: f64, d: f64| FrontierPoint {
 ///     model: "f2_sim".into(),
 ///     method: "LinUCB-QG".into(),

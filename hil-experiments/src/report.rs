@@ -4,9 +4,10 @@
 use std::fmt::Write as _;
 
 use hil_core::Result;
+use hil_stats::Stat;
 
 use crate::published::{self, PublishedRow};
-use crate::results::{MetricSummary, ProtocolResults, Spread, Stat};
+use crate::results::{MetricSummary, ProtocolResults, Spread};
 
 fn pm(s: Stat, spread: Spread) -> String {
     format!("{:.3} ± {:.3}", s.mean, spread.of(s))

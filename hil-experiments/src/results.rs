@@ -2,14 +2,13 @@
 //! aggregated results of a protocol run.
 
 use hil_core::{HilError, Result};
+use hil_stats::{Stat, mean};
 use serde::{Deserialize, Serialize};
 
 use hil_core::EpisodeMetrics;
 
 use crate::method::GridPoint;
 use crate::testbed::{NamedModel, Phase, ProtocolSettings, RunRecord};
-
-pub use hil_core::metrics::Stat;
 
 /// Which spread a table reports after ±.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -238,10 +237,10 @@ fn select(
             ));
         }
         let scored = score_all(&runs, &models[m])?;
-        let mean = scored.iter().map(|x| x.m_wt(w_task)).sum::<f64>() / scored.len() as f64;
-        table.push((cand.0.as_ref().map_or(0.0, |h| h.1), mean));
-        if best.as_ref().is_none_or(|(_, b)| mean > *b) {
-            best = Some((cand, mean));
+        let m_wt = mean(&scored.iter().map(|x| x.m_wt(w_task)).collect::<Vec<_>>());
+        table.push((cand.0.as_ref().map_or(0.0, |h| h.1), m_wt));
+        if best.as_ref().is_none_or(|(_, b)| m_wt > *b) {
+            best = Some((cand, m_wt));
         }
     }
     let (chosen, _) = best.ok_or_else(|| HilError::state("protocol", "empty grid"))?;

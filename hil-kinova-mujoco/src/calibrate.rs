@@ -34,15 +34,17 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-use hil_core::metrics::Stat;
 use hil_core::{ArmId, Environment, HilError, Result};
+use hil_stats::{
+    Alternative, Stat, binomial_pmf, binomial_se, binomial_upper_tail, bonferroni, convolve,
+    fisher_exact,
+};
 use serde::Serialize;
 
 use crate::controller::{ACTIONS, RollBy};
 use crate::env::{KinovaFeedingConfig, KinovaFeedingEnv};
 use crate::food::{FoodKind, Setting};
 use crate::sim::AttemptReport;
-use hil_workload::stats::{Alternative, fisher_exact};
 
 /// What to calibrate.
 #[derive(Clone, Debug, PartialEq)]
@@ -326,7 +328,14 @@ pub fn calibrate_with(
     }
     let rows = tabulate(opts, &records);
     let (in_step, busy) = timing;
-    let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    // 0 when no cell has a published rate to compare with.
+    let mean = |v: Vec<f64>| {
+        if v.is_empty() {
+            0.0
+        } else {
+            hil_stats::mean(&v)
+        }
+    };
     // The overall rows that have a published rate to compare with.
     let compared: Vec<&CalibrationRow> = rows.iter().filter(|r| r.published.is_some()).collect();
     let errors: Vec<f64> = compared
@@ -531,39 +540,6 @@ fn error_bin(e: f64) -> usize {
 /// Rounding allowance when comparing an error with a target.
 const TARGET_TOLERANCE: f64 = 1e-9;
 
-/// Probabilities of 0..=n successes in n trials at rate p.
-fn binomial_pmf(n: usize, p: f64) -> Vec<f64> {
-    let mut out = Vec::with_capacity(n + 1);
-    let mut c = 1.0; // n choose k, built up as k grows
-    for k in 0..=n {
-        if k > 0 {
-            c *= (n - k + 1) as f64 / k as f64;
-        }
-        out.push(c * p.powi(k as i32) * (1.0 - p).powi((n - k) as i32));
-    }
-    out
-}
-
-/// The distribution of the sum of two independent counts.
-fn convolve(a: &[f64], b: &[f64]) -> Vec<f64> {
-    let mut out = vec![0.0; a.len() + b.len() - 1];
-    for (i, x) in a.iter().enumerate() {
-        for (j, y) in b.iter().enumerate() {
-            out[i + j] += x * y;
-        }
-    }
-    out
-}
-
-/// Binomial standard error of a rate of `successes` in `trials`.
-pub fn binomial_se(successes: usize, trials: usize) -> f64 {
-    if trials == 0 {
-        return 0.0;
-    }
-    let p = successes as f64 / trials as f64;
-    (p * (1.0 - p) / trials as f64).sqrt()
-}
-
 /// Fisher's exact two-sided p-value that the counted attempts of `t` and
 /// the published attempts behind `published` (one rate per setting, each
 /// over [`PUBLISHED_TRIALS_PER_SETTING`] trials) share one success rate;
@@ -640,13 +616,10 @@ impl Consistency {
         Consistency {
             cells: tested.len(),
             below_0_05,
-            p_this_many_below_0_05: binomial_pmf(tested.len(), 0.05)[below_0_05..]
-                .iter()
-                .sum::<f64>()
-                .min(1.0),
+            p_this_many_below_0_05: binomial_upper_tail(tested.len(), 0.05, below_0_05),
             least_consistent,
             smallest_p,
-            smallest_p_adjusted: (smallest_p * tested.len() as f64).min(1.0),
+            smallest_p_adjusted: bonferroni(smallest_p, tested.len()),
         }
     }
 }

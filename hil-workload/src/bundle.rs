@@ -3,13 +3,13 @@
 //! `hil workload bundle` runs [`build_bundle`] on [`bundled_study`] and
 //! writes `data/synthetic_study.csv` and `models/*.json`.
 
-use hil_core::Result;
+use hil_core::{HilError, Result};
+use hil_stats::{Alternative, StatsError, TestResult, mann_whitney_u, mean, mean_std};
 use serde::{Deserialize, Serialize};
 
-use crate::datasets::{Dataset, DatasetId, mean_std};
+use crate::datasets::{Dataset, DatasetId};
 use crate::models::{FittedModel, Provenance};
 use crate::select::{Candidate, SelectOptions, SelectionTable, cross_validate, fit_on_all};
-use crate::stats::{Alternative, TestResult, mann_whitney_u};
 use crate::study::Study;
 use crate::synth::SynthConfig;
 
@@ -41,7 +41,7 @@ impl StudySummary {
             if let Some(d) = Dataset::build_if_any(study, id)? {
                 let t = d.targets();
                 let (m, s) = mean_std(&t);
-                let wl0 = d.pairs.iter().map(|p| p.wl0).sum::<f64>() / d.pairs.len() as f64;
+                let wl0 = mean(&d.pairs.iter().map(|p| p.wl0).collect::<Vec<_>>());
                 datasets.push((id, t.len(), m, s, wl0));
                 targets.push((id, t));
             }
@@ -51,7 +51,11 @@ impl StudySummary {
         }
         let get = |id| targets.iter().find(|(d, _)| *d == id).map(|(_, t)| t);
         let d1_less_than_d2 = match (get(DatasetId::D1), get(DatasetId::D2)) {
-            (Some(a), Some(b)) => Some(mann_whitney_u(a, b, Alternative::Less)?),
+            (Some(a), Some(b)) => Some(mann_whitney_u(a, b, Alternative::Less).map_err(
+                |StatsError::InvalidSample { sample, reason }| {
+                    HilError::invalid_input(sample, reason)
+                },
+            )?),
             _ => None,
         };
         Ok(Self {

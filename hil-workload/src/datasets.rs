@@ -329,5 +329,3 @@ pub(crate) fn no_query_rows(study: &Study, id: DatasetId) -> HilError {
         why: format!("dataset {} has no query rows", id.as_str().to_uppercase()),
     }
 }
-
-pub use hil_core::metrics::mean_std;

@@ -38,7 +38,6 @@ pub mod fit;
 pub mod models;
 pub mod seeds;
 pub mod select;
-pub mod stats;
 pub mod study;
 pub mod synth;
 pub mod tlx;

@@ -16,8 +16,8 @@
 use std::ops::Range;
 
 use hil_core::Result;
-use hil_core::metrics::Stat;
 use hil_paper::workload_study::{D1_BELOW_D2_P, D1_WORKLOAD, D2_WORKLOAD};
+use hil_stats::Stat;
 use serde::{Deserialize, Serialize};
 
 use crate::bundle::StudySummary;
@@ -94,7 +94,7 @@ impl SeedSpread {
             .collect::<Result<_>>()?;
         let col = |f: &dyn Fn(&Draw) -> f64| Stat::of(&draws.iter().map(f).collect::<Vec<_>>());
         let ps: Vec<f64> = draws.iter().map(|d| d.p).collect();
-        let p_median = crate::select::median(&ps);
+        let p_median = hil_stats::median(&ps);
         let p_below_005 = ps.iter().filter(|p| **p < 0.05).count() as f64 / ps.len().max(1) as f64;
         Ok(Self {
             d1_mean: col(&|d| d.d1.1),

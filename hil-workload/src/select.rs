@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use std::fmt::Write as _;
 
 use hil_core::{HilError, Result};
+use hil_stats::{mean, mean_std, median};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use serde::{Deserialize, Serialize};
@@ -216,21 +217,6 @@ pub struct SelectionTable {
     pub rows: Vec<ScoreRow>,
 }
 
-/// Median (mean of the two middle values for even counts).
-pub fn median(xs: &[f64]) -> f64 {
-    let mut v = xs.to_vec();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// A training split (parts and inner CV groups) with its normal equations.
 #[derive(Debug)]
 pub struct Split {
@@ -368,13 +354,13 @@ impl<'a> Problem<'a> {
         let mut best = (f64::INFINITY, lambdas[0]);
         let mut warm: Vec<Option<Vec<f64>>> = vec![None; split.inner.len()];
         for &lambda in lambdas {
-            let mut total = 0.0;
+            let mut inner_mse = Vec::with_capacity(split.inner.len());
             for (j, grp) in split.inner.iter().enumerate() {
                 let w = Self::solve(variant, &split.g_inner[j], h, lambda, warm[j].as_deref())?;
-                total += self.mse_linear(grp, &w);
+                inner_mse.push(self.mse_linear(grp, &w));
                 warm[j] = Some(w);
             }
-            let score = total / split.inner.len() as f64;
+            let score = mean(&inner_mse);
             if score < best.0 {
                 best = (score, lambda);
             }
@@ -441,9 +427,7 @@ fn n_parts(opts: &SelectOptions) -> usize {
 
 fn score_row(dataset: DatasetId, candidate: Candidate, fold: Vec<(f64, Option<f64>)>) -> ScoreRow {
     let fold_mse: Vec<f64> = fold.iter().map(|f| f.0).collect();
-    let n = fold_mse.len() as f64;
-    let mean = fold_mse.iter().sum::<f64>() / n;
-    let std = (fold_mse.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt();
+    let (mean, std) = mean_std(&fold_mse);
     ScoreRow {
         dataset,
         candidate,

@@ -26,6 +26,7 @@ use hil_core::{
     LabelledObservation, QueryHistory, Result, Timestep, WorkloadForecast, WorkloadModel,
 };
 use hil_policies::{EstimatorConfig, LinearArms, Representation};
+use hil_stats::{median, quantile};
 use serde_json::json;
 
 use spec::PolicySpec;
@@ -277,19 +278,17 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
             decide_us.push((mid - start).as_secs_f64() * 1e6);
         }
     }
-    let per_step_us = median(&mut step_us.clone());
-    let decide_median = median(&mut decide_us);
+    let per_step_us = median(&step_us);
+    let decide_median = median(&decide_us);
     let bw = (!bw_buf.is_empty()).then(|| {
         bw_samples.push(read_bandwidth(&bw_buf));
-        median(&mut bw_samples)
+        median(&bw_samples)
     });
     let load = std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|s| s.split_whitespace().next().map(str::to_string))
         .unwrap_or_default();
-    let mut sorted = step_us.clone();
-    sorted.sort_by(f64::total_cmp);
-    let pct = |p: f64| sorted[((sorted.len() - 1) as f64 * p).round() as usize];
+    let pct = |p: f64| quantile(&step_us, p);
     let floors = traffic
         .zip(bw)
         .map(|(tr, bw)| Floors::new(&tr, bw, per_step_us, pct(0.1)));
@@ -411,16 +410,6 @@ impl Floors {
             floor_with_writes_us,
             ratio_with_writes: median_us / floor_with_writes_us,
         }
-    }
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
     }
 }
 

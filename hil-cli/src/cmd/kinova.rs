@@ -695,7 +695,7 @@ fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
 /// `hil demo kinova --seeds N`: the whole study on N consecutive master
 /// seeds (in parallel), every figure as mean ± standard error over seeds.
 fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
-    use hil_experiments::user_study::{across_seeds, mean_sem};
+    use hil_experiments::user_study::across_seeds;
     if args.render.is_some() {
         return Err(HilError::invalid_parameter(
             "--render",
@@ -780,9 +780,9 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
         println!(
             "{:<12} r_task_avg {}  n_success {}  n_q {}{paper}",
             row.method,
-            pm(r.mean, r.sem, 3),
-            pm(s.mean, s.sem, 2),
-            pm(q.mean, q.sem, 2)
+            pm(r.mean, r.sem(), 3),
+            pm(s.mean, s.sem(), 2),
+            pm(q.mean, q.sem(), 2)
         );
     }
     println!("where each method asks: queries per plate at each food, and at each attempt index");
@@ -790,13 +790,13 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
         let foods: Vec<String> = row
             .n_q_per_plate_by_food
             .iter()
-            .map(|(f, m)| format!("{f} {}", pm(m.mean, m.sem, 2)))
+            .map(|(f, m)| format!("{f} {}", pm(m.mean, m.sem(), 2)))
             .collect();
         let attempts: Vec<String> = row
             .n_q_per_plate_by_attempt
             .iter()
             .enumerate()
-            .map(|(i, m)| format!("#{} {}", i + 1, pm(m.mean, m.sem, 2)))
+            .map(|(i, m)| format!("#{} {}", i + 1, pm(m.mean, m.sem(), 2)))
             .collect();
         println!(
             "{:<12} {}; attempt {}",
@@ -814,14 +814,14 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
             .find(|c| &c.0 == m)
             .map(|c| c.1.clone())
             .unwrap_or_default();
-        let ms = mean_sem(&vals);
+        let ms = hil_stats::Stat::of(&vals);
         println!(
             "{m} {param} chosen on validation (highest mean M_wt) per seed: {} (mean {})",
             vals.iter()
                 .map(|v| v.to_string())
                 .collect::<Vec<_>>()
                 .join(", "),
-            pm(ms.mean, ms.sem, 2)
+            pm(ms.mean, ms.sem(), 2)
         );
     }
     Ok(())

@@ -52,7 +52,7 @@ pub use config::{
     PAPER_N_ATT, PAPER_VALIDATION_W_TASK, PAPER_W_GRID, PAPER_WORKLOAD, UserStudyConfig, Validation,
 };
 pub use run::{
-    Episode, MeanSem, MethodSummary, Plate, PlateResult, Protocol, Selection, UserStudy,
-    UserStudyResult, mean_sem, method_order,
+    Episode, MethodSummary, Plate, PlateResult, Protocol, Selection, UserStudy, UserStudyResult,
+    method_order,
 };
 pub use seeds::{MethodAcrossSeeds, PAPER_STUDY, across_seeds};

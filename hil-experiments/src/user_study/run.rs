@@ -4,12 +4,12 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use hil_core::metrics::mean_std;
 use hil_core::session::splitmix;
 use hil_core::{
     Environment, EpisodeReport, Policy, Result, Session, SessionObserver, TaskContext,
     WorkloadModel,
 };
+use hil_stats::{Stat, mean};
 use serde::{Deserialize, Serialize};
 
 use super::config::UserStudyConfig;
@@ -91,8 +91,10 @@ pub struct Selection {
     pub parameter: String,
     /// The grid of values tried.
     pub grid: Vec<f64>,
-    /// Mean M_wt(`w_task`) over the validation plates, per grid value.
-    pub m_wt: Vec<MeanSem>,
+    /// Mean M_wt(`w_task`) over the validation plates, per grid value,
+    /// with its standard error (written as `{mean, sem}`).
+    #[serde(with = "hil_stats::summary::as_mean_sem::seq")]
+    pub m_wt: Vec<Stat>,
     /// Mean queries per validation plate, per grid value.
     pub n_q: Vec<f64>,
     /// The task weight of the criterion.
@@ -105,31 +107,6 @@ pub struct Selection {
 
 /// Seed stream of validation plates (apart from the study's plates).
 const VALIDATION_STREAM: u64 = 0x7661_6c69_6461_7465;
-
-/// A mean over plates with its standard error.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct MeanSem {
-    /// The mean.
-    pub mean: f64,
-    /// Its standard error (sample standard deviation / √n); `None` with
-    /// fewer than two values, where it is undefined.
-    pub sem: Option<f64>,
-}
-
-/// Mean and standard error of `xs` ([`hil_core::metrics::standard_error`]).
-///
-/// ```
-/// use hil_experiments::user_study::mean_sem;
-/// let m = mean_sem(&[1.0, 3.0]);
-/// assert_eq!((m.mean, m.sem), (2.0, Some(1.0)));
-/// assert_eq!(mean_sem(&[5.0]).sem, None);
-/// ```
-pub fn mean_sem(xs: &[f64]) -> MeanSem {
-    MeanSem {
-        mean: mean_std(xs).0,
-        sem: hil_core::metrics::standard_error(xs),
-    }
-}
 
 /// One method's figures, mean ± standard error over its plates.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -162,7 +139,7 @@ pub struct MethodSummary {
 impl MethodSummary {
     fn over(method: &str, plates: &[&PlateResult]) -> Self {
         let col =
-            |f: fn(&PlateResult) -> f64| mean_sem(&plates.iter().map(|p| f(p)).collect::<Vec<_>>());
+            |f: fn(&PlateResult) -> f64| Stat::of(&plates.iter().map(|p| f(p)).collect::<Vec<_>>());
         let r = col(|p| p.r_task_avg);
         let s = col(|p| p.n_success as f64);
         let q = col(|p| p.n_q as f64);
@@ -180,22 +157,23 @@ impl MethodSummary {
             .unwrap_or(0);
         let n_q_by_attempt = (0..depth)
             .map(|i| {
-                plates
-                    .iter()
-                    .map(|p| p.n_q_by_attempt.get(i).copied().unwrap_or(0) as f64)
-                    .sum::<f64>()
-                    / n
+                mean(
+                    &plates
+                        .iter()
+                        .map(|p| p.n_q_by_attempt.get(i).copied().unwrap_or(0) as f64)
+                        .collect::<Vec<_>>(),
+                )
             })
             .collect();
         Self {
             method: method.to_string(),
             plates: plates.len(),
             r_task_avg: r.mean,
-            r_task_avg_sem: r.sem,
+            r_task_avg_sem: r.sem(),
             n_success_per_plate: s.mean,
-            n_success_per_plate_sem: s.sem,
+            n_success_per_plate_sem: s.sem(),
             n_q_per_plate: q.mean,
-            n_q_per_plate_sem: q.sem,
+            n_q_per_plate_sem: q.sem(),
             n_q_by_food,
             n_q_by_attempt,
         }
@@ -509,7 +487,7 @@ impl UserStudy<'_> {
                     scores.push(report.metrics.m_wt(v.w_task));
                     queries += report.metrics.n_q;
                 }
-                m_wt.push(mean_sem(&scores));
+                m_wt.push(Stat::of(&scores));
                 n_q.push(queries as f64 / v.plates as f64);
             }
             let best =
@@ -574,12 +552,5 @@ mod tests {
                 [1, 0, 2]
             ]
         );
-    }
-
-    #[test]
-    fn mean_sem_of_constant_is_zero() {
-        let m = mean_sem(&[2.0, 2.0, 2.0]);
-        assert_eq!((m.mean, m.sem), (2.0, Some(0.0)));
-        assert!(mean_sem(&[]).mean.is_nan());
     }
 }

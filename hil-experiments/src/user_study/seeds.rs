@@ -3,9 +3,10 @@
 
 use std::collections::BTreeMap;
 
+use hil_stats::Stat;
 use serde::Serialize;
 
-use super::run::{MeanSem, MethodSummary, UserStudyResult, mean_sem};
+use super::run::{MethodSummary, UserStudyResult};
 
 /// The paper's real-robot user study, per method: (label, r_task_avg,
 /// n_success per plate, n_q per plate), means (the paper's user-study
@@ -23,16 +24,21 @@ pub struct MethodAcrossSeeds {
     /// The method's label.
     pub method: String,
     /// r_task_avg.
-    pub r_task_avg: MeanSem,
+    #[serde(with = "hil_stats::summary::as_mean_sem")]
+    pub r_task_avg: Stat,
     /// Items fed per plate.
-    pub n_success_per_plate: MeanSem,
+    #[serde(with = "hil_stats::summary::as_mean_sem")]
+    pub n_success_per_plate: Stat,
     /// Queries per plate.
-    pub n_q_per_plate: MeanSem,
+    #[serde(with = "hil_stats::summary::as_mean_sem")]
+    pub n_q_per_plate: Stat,
     /// Queries per plate at each food (a seed that never asked at a food
     /// counts 0 there).
-    pub n_q_per_plate_by_food: BTreeMap<String, MeanSem>,
+    #[serde(with = "hil_stats::summary::as_mean_sem::map")]
+    pub n_q_per_plate_by_food: BTreeMap<String, Stat>,
     /// Queries per plate at each attempt index (first attempt first).
-    pub n_q_per_plate_by_attempt: Vec<MeanSem>,
+    #[serde(with = "hil_stats::summary::as_mean_sem::seq")]
+    pub n_q_per_plate_by_attempt: Vec<Stat>,
     /// The paper's real-study figures for a method of this label:
     /// r_task_avg, n_success and n_q per plate ([`PAPER_STUDY`]).
     pub paper: Option<[f64; 3]>,
@@ -62,7 +68,7 @@ fn of_method(runs: &[UserStudyResult], label: &str) -> MethodAcrossSeeds {
         .filter_map(|r| r.methods.iter().find(|m| m.method == label))
         .collect();
     let over = |f: &dyn Fn(&MethodSummary) -> f64| {
-        mean_sem(&mine.iter().map(|m| f(m)).collect::<Vec<_>>())
+        Stat::of(&mine.iter().map(|m| f(m)).collect::<Vec<_>>())
     };
     let foods: std::collections::BTreeSet<&String> =
         mine.iter().flat_map(|m| m.n_q_by_food.keys()).collect();

@@ -31,7 +31,7 @@ impl AverageModel {
             ));
         }
         Ok(Self {
-            value: pairs.iter().map(|p| p.wl0).sum::<f64>() / pairs.len() as f64,
+            value: hil_stats::mean(&pairs.iter().map(|p| p.wl0).collect::<Vec<_>>()),
         })
     }
 

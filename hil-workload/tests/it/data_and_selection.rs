@@ -3,9 +3,10 @@
 
 use std::path::Path;
 
+use hil_stats::{mean_std, median};
 use hil_workload::bundle::StudySummary;
-use hil_workload::datasets::{Dataset, DatasetId, mean_std};
-use hil_workload::select::{Candidate, SelectOptions, cross_validate, median};
+use hil_workload::datasets::{Dataset, DatasetId};
+use hil_workload::select::{Candidate, SelectOptions, cross_validate};
 use hil_workload::study::Study;
 use hil_workload::synth::SynthConfig;
 

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use hil_core::{HilError, Result};
 use hil_experiments::{Protocol, ProtocolSettings};
+use hil_stats::quantile;
 use serde_json::json;
 
 /// Arguments of `hil bench reproduce`.
@@ -32,8 +33,6 @@ pub fn bench_reproduce(a: &ReproduceBench) -> Result<()> {
         wall.push(t0.elapsed().as_secs_f64());
         episodes = records.len();
     }
-    let mut sorted = wall.clone();
-    sorted.sort_by(f64::total_cmp);
     let load = std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|s| s.split_whitespace().next().map(str::to_string))
@@ -44,8 +43,9 @@ pub fn bench_reproduce(a: &ReproduceBench) -> Result<()> {
         "threads": threads,
         "runs": a.runs,
         "wall_s": wall,
-        "wall_s_min": sorted.first(),
-        "wall_s_median": sorted[sorted.len() / 2],
+        "wall_s_min": quantile(&wall, 0.0),
+        // The upper of the two middle runs for an even count.
+        "wall_s_median": quantile(&wall, 0.5),
         "loadavg_1min_at_end": load,
     });
     println!(

@@ -1,39 +1,14 @@
 //! Rank tests used in the paper: one-sided Mann-Whitney U between
-//! populations and the Wilcoxon signed-rank test for paired comparisons;
-//! and Fisher's exact test of two success counts sharing one rate (a
-//! simulated success rate against a published one).
+//! populations and the Wilcoxon signed-rank test for paired comparisons.
 //!
 //! Small samples without ties use exact null distributions; otherwise the
 //! normal approximation with tie and continuity corrections (the usual
 //! large-sample method). Normal tail probabilities come from `statrs`.
 
-use hil_core::{HilError, Result};
-use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, Normal};
-use statrs::function::factorial::ln_binomial;
 
-/// The alternative hypothesis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Alternative {
-    /// The first sample is stochastically smaller (or differences < 0).
-    Less,
-    /// The first sample is stochastically greater (or differences > 0).
-    Greater,
-    /// Either direction.
-    TwoSided,
-}
-
-/// A test statistic and its p-value.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct TestResult {
-    /// U of the first sample (Mann-Whitney) or W+ (Wilcoxon).
-    pub statistic: f64,
-    /// The p-value under the chosen alternative.
-    pub p_value: f64,
-    /// True if the exact null distribution was used.
-    pub exact: bool,
-}
+use crate::error::{Result, StatsError};
+use crate::hypothesis::{Alternative, TestResult};
 
 /// Exact methods are used up to this many observations (no ties).
 pub const EXACT_LIMIT: usize = 50;
@@ -61,12 +36,12 @@ fn midranks(v: &[f64]) -> (Vec<f64>, f64) {
     (ranks, ties)
 }
 
-fn check(name: &str, xs: &[f64]) -> Result<()> {
+fn check(name: &'static str, xs: &[f64]) -> Result<()> {
     if xs.is_empty() {
-        return Err(HilError::invalid_input(name, "empty sample"));
+        return Err(StatsError::sample(name, "empty sample"));
     }
     if let Some(x) = xs.iter().find(|x| !x.is_finite()) {
-        return Err(HilError::invalid_input(name, format!("{x} is not finite")));
+        return Err(StatsError::sample(name, format!("{x} is not finite")));
     }
     Ok(())
 }
@@ -93,7 +68,7 @@ fn normal_p(alt: Alternative, stat: f64, mean: f64, sd: f64) -> f64 {
 /// Mann-Whitney U test of `x` against `y`.
 ///
 /// ```
-/// use hil_workload::stats::{mann_whitney_u, Alternative};
+/// use hil_stats::{mann_whitney_u, Alternative};
 /// let r = mann_whitney_u(&[1.0, 2.0, 3.0, 4.0, 5.0], &[6.0, 7.0, 8.0, 9.0, 10.0], Alternative::Less).unwrap();
 /// assert_eq!(r.statistic, 0.0);
 /// assert!((r.p_value - 1.0 / 252.0).abs() < 1e-12); // one arrangement in C(10, 5)
@@ -149,79 +124,10 @@ pub fn mann_whitney_u(x: &[f64], y: &[f64], alt: Alternative) -> Result<TestResu
     })
 }
 
-/// Fisher's exact test that `successes_a` of `trials_a` and `successes_b`
-/// of `trials_b` come from one success rate: conditional on the total
-/// successes, the first count is hypergeometric. `Less` asks whether the
-/// first sample's rate is lower; `TwoSided` sums the probabilities of every
-/// count no more likely than the one observed (R's `fisher.test`), with a
-/// relative allowance of 10⁻⁷ so that ties in floating point count as ties.
-/// The statistic is `successes_a`; the test is exact, and conservative as
-/// every test on counts is.
-///
-/// ```
-/// use hil_workload::stats::{fisher_exact, Alternative};
-/// // Fisher's tea taster: 3 of 4 cups right against 1 of 4.
-/// let r = fisher_exact(3, 4, 1, 4, Alternative::Greater).unwrap();
-/// assert!((r.p_value - 17.0 / 70.0).abs() < 1e-12);
-/// let two = fisher_exact(3, 4, 1, 4, Alternative::TwoSided).unwrap();
-/// assert!((two.p_value - 34.0 / 70.0).abs() < 1e-12);
-/// ```
-pub fn fisher_exact(
-    successes_a: u64,
-    trials_a: u64,
-    successes_b: u64,
-    trials_b: u64,
-    alt: Alternative,
-) -> Result<TestResult> {
-    for (name, s, n) in [
-        ("first sample", successes_a, trials_a),
-        ("second sample", successes_b, trials_b),
-    ] {
-        if n == 0 {
-            return Err(HilError::invalid_input(name, "no trials"));
-        }
-        if s > n {
-            return Err(HilError::invalid_input(
-                name,
-                format!("{s} successes in {n} trials"),
-            ));
-        }
-    }
-    let total = successes_a + successes_b;
-    let lo = total.saturating_sub(trials_b);
-    let hi = total.min(trials_a);
-    let ln_all = ln_binomial(trials_a + trials_b, total);
-    let pmf = |x: u64| (ln_binomial(trials_a, x) + ln_binomial(trials_b, total - x) - ln_all).exp();
-    let observed = pmf(successes_a);
-    let (mut p_le, mut p_ge, mut p_two) = (0.0, 0.0, 0.0);
-    for x in lo..=hi {
-        let p = pmf(x);
-        if x <= successes_a {
-            p_le += p;
-        }
-        if x >= successes_a {
-            p_ge += p;
-        }
-        if p <= observed * (1.0 + 1e-7) {
-            p_two += p;
-        }
-    }
-    let p_value = match alt {
-        Alternative::Less => p_le,
-        Alternative::Greater => p_ge,
-        Alternative::TwoSided => p_two,
-    };
-    Ok(TestResult {
-        statistic: successes_a as f64,
-        p_value: p_value.min(1.0),
-        exact: true,
-    })
-}
-
 /// Wilcoxon signed-rank test on the differences `x − y` (zeros dropped).
 ///
 /// ```
-/// use hil_workload::stats::{wilcoxon_signed_rank, Alternative};
+/// use hil_stats::{wilcoxon_signed_rank, Alternative};
 /// let x: Vec<f64> = (1..=10).map(|i| i as f64 + 0.5 * i as f64).collect();
 /// let y: Vec<f64> = (1..=10).map(|i| i as f64).collect();
 /// let r = wilcoxon_signed_rank(&x, &y, Alternative::Greater).unwrap();
@@ -232,7 +138,7 @@ pub fn wilcoxon_signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<Te
     check("first sample", x)?;
     check("second sample", y)?;
     if x.len() != y.len() {
-        return Err(HilError::invalid_input(
+        return Err(StatsError::sample(
             "paired samples",
             format!("lengths differ: {} and {}", x.len(), y.len()),
         ));
@@ -244,7 +150,7 @@ pub fn wilcoxon_signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<Te
         .filter(|d| *d != 0.0)
         .collect();
     if d.is_empty() {
-        return Err(HilError::invalid_input(
+        return Err(StatsError::sample(
             "paired samples",
             "all differences are zero",
         ));
@@ -290,45 +196,6 @@ pub fn wilcoxon_signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<Te
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn fisher_exact_matches_enumerated_tables() {
-        // 0 of 30 against 53 of 960: the two-sided p-value sums the
-        // hypergeometric tables no likelier than the observed one; checked
-        // here against a direct product of binomial coefficients.
-        let r = fisher_exact(0, 30, 53, 960, Alternative::TwoSided).unwrap();
-        let choose =
-            |n: u64, k: u64| -> f64 { (0..k).map(|i| (n - i) as f64 / (i + 1) as f64).product() };
-        let all = choose(990, 53);
-        let p = |x: u64| choose(30, x) * choose(960, 53 - x) / all;
-        let expect: f64 = (0..=30).map(p).filter(|&q| q <= p(0) * (1.0 + 1e-7)).sum();
-        assert!(
-            (r.p_value - expect).abs() < 1e-9,
-            "{} vs {expect}",
-            r.p_value
-        );
-        assert!(r.p_value > 0.3 && r.p_value < 0.5, "{r:?}");
-        // Identical rates: nothing is less likely than the mode's neighbours.
-        let same = fisher_exact(10, 20, 10, 20, Alternative::TwoSided).unwrap();
-        assert!((same.p_value - 1.0).abs() < 1e-12);
-        // One-sided tails add up to 1 plus the observed table's probability.
-        let le = fisher_exact(2, 10, 7, 10, Alternative::Less).unwrap();
-        let ge = fisher_exact(2, 10, 7, 10, Alternative::Greater).unwrap();
-        assert!((le.p_value + ge.p_value - 1.0 - p_of(2, 10, 7, 10)).abs() < 1e-12);
-        assert!(le.p_value < 0.05 && ge.p_value > 0.95);
-    }
-
-    fn p_of(a: u64, n1: u64, b: u64, n2: u64) -> f64 {
-        (ln_binomial(n1, a) + ln_binomial(n2, b) - ln_binomial(n1 + n2, a + b)).exp()
-    }
-
-    #[test]
-    fn fisher_exact_rejects_impossible_counts() {
-        for (a, n1, b, n2) in [(3, 2, 0, 5), (0, 5, 6, 5), (0, 0, 1, 5), (1, 5, 0, 0)] {
-            let err = fisher_exact(a, n1, b, n2, Alternative::TwoSided).unwrap_err();
-            assert!(matches!(err, HilError::InvalidInput { .. }), "{err:?}");
-        }
-    }
 
     #[test]
     fn mann_whitney_textbook_values() {

@@ -20,7 +20,7 @@
 //! `hil_policies::demo_learner` (`demo_learner`) and
 //! `hil_workload::demo_counting` (`demo_counting`).
 //!
-//! Every channel passes `hil_core::testing::check_query_channel` (the human
+//! Every channel passes `hil_conformance::check_query_channel` (the human
 //! ones with a scripted person at the other end, in their tests).
 
 pub mod present;

@@ -7,9 +7,9 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, LogNormal};
 use serde::{Deserialize, Serialize};
 
-use hil_core::TaskContext;
+use hil_config::TaskContext;
+use hil_config::{QueryChannelConfig, limits};
 use hil_core::channel::PerfectExpert;
-use hil_core::config::{QueryChannelConfig, limits};
 use hil_core::session::splitmix;
 use hil_core::{
     Answer, ArmId, BoundingBox, HilError, Query, QueryChannel, Response, ResponseType, Result,
@@ -140,7 +140,7 @@ impl QueryChannelConfig for SimulatedExpertConfig {
 /// ```
 /// use hil_channels::{SimulatedExpert, SimulatedExpertConfig};
 /// let mut perfect = SimulatedExpert::new(SimulatedExpertConfig::default()).unwrap();
-/// hil_core::testing::check_query_channel(&mut perfect, 18).unwrap();
+/// hil_conformance::check_query_channel(&mut perfect, 18).unwrap();
 /// let noisy = SimulatedExpert::new(SimulatedExpertConfig { error_rate: 0.2, ..Default::default() });
 /// assert!(noisy.is_ok());
 /// ```

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use hil_core::config::QueryChannelConfig;
+use hil_config::QueryChannelConfig;
 use hil_core::{
     Answer, BoundingBox, HilError, Query, QueryChannel, Response, ResponseType, Result,
 };
@@ -13,7 +13,7 @@ use hil_core::{
 use crate::present::{
     check_bbox, check_text, describe_item, describe_kind, question, validate_answer,
 };
-use hil_core::TaskContext;
+use hil_config::TaskContext;
 
 /// Config of the terminal channel, `type = "terminal"` (no parameters): the
 /// prompt is written to standard error and answers are read from standard

@@ -6,7 +6,7 @@ use crate::query::{Query, Response};
 /// Poses queries to an expert (a person, or a simulated one) and returns the
 /// answer.
 ///
-/// Contract (checked by `hil_core::testing::check_query_channel`): a
+/// Contract (checked by `hil_conformance::check_query_channel`): a
 /// response's `expert_arm`, when present, indexes the query's action space;
 /// response times are finite and non-negative.
 ///

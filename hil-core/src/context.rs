@@ -1,4 +1,5 @@
-//! Contexts: the d-dimensional feature vector the policy sees for one observation.
+//! What the robot sees: the [`Item`] in front of it and its [`Context`], the
+//! d-dimensional feature vector the policy sees for one observation.
 
 use std::sync::Arc;
 
@@ -103,5 +104,40 @@ pub fn check_finite(what: &str, values: &[f64]) -> Result<()> {
             format!("{} is not finite", values[i]),
         )),
         None => Ok(()),
+    }
+}
+
+/// One item the robot must handle (a food piece on the plate).
+///
+/// ```
+/// let item = hil_core::Item::new(0, "banana").with_description("on the plate's rim");
+/// assert_eq!((item.index, item.label.as_str()), (0, "banana"));
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct Item {
+    /// Position of the item in the episode (0-based).
+    pub index: usize,
+    /// The item's type (e.g. `banana`).
+    pub label: String,
+    /// Free-form description a human channel may show.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
+}
+
+impl Item {
+    /// Item number `index` (0-based) of type `label`.
+    pub fn new(index: usize, label: impl Into<String>) -> Self {
+        Self {
+            index,
+            label: label.into(),
+            description: None,
+        }
+    }
+
+    /// With a description a human channel may show.
+    pub fn with_description(mut self, description: impl Into<String>) -> Self {
+        self.description = Some(description.into());
+        self
     }
 }

@@ -1,51 +1,16 @@
 //! The [`Environment`] trait: items to act on, contexts, and outcomes.
-
-use serde::{Deserialize, Serialize};
+//! (An [`Item`] and its [`Context`] are vocabulary of their own, in
+//! [`crate::context`], since queries describe them too.)
 
 use crate::action::{ActionSpace, ArmId};
-use crate::context::Context;
+use crate::context::{Context, Item};
 use crate::decision::Outcome;
 use crate::error::{HilError, Result};
-
-/// One item the robot must handle (a food piece on the plate).
-///
-/// ```
-/// let item = hil_core::Item::new(0, "banana").with_description("on the plate's rim");
-/// assert_eq!((item.index, item.label.as_str()), (0, "banana"));
-/// ```
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[non_exhaustive]
-pub struct Item {
-    /// Position of the item in the episode (0-based).
-    pub index: usize,
-    /// The item's type (e.g. `banana`).
-    pub label: String,
-    /// Free-form description a human channel may show.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub description: Option<String>,
-}
-
-impl Item {
-    /// Item number `index` (0-based) of type `label`.
-    pub fn new(index: usize, label: impl Into<String>) -> Self {
-        Self {
-            index,
-            label: label.into(),
-            description: None,
-        }
-    }
-
-    /// With a description a human channel may show.
-    pub fn with_description(mut self, description: impl Into<String>) -> Self {
-        self.description = Some(description.into());
-        self
-    }
-}
 
 /// A task the robot acts in: a seeded, replayable sequence of items, each
 /// observed as a fresh context at every attempt.
 ///
-/// Contract (checked by `hil_core::testing::check_environment`):
+/// Contract (checked by `hil_conformance::check_environment`):
 /// - after `reset(seed)` the same seed replays the same items, contexts and
 ///   outcomes for the same actions;
 /// - `observe` returns contexts of dimension `context_dim()`;

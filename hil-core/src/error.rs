@@ -4,7 +4,7 @@
 //! the kind of failure, and every message names what was wrong and where.
 
 use std::borrow::Cow;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Result alias used across hil.
 pub type Result<T, E = HilError> = std::result::Result<T, E>;
@@ -53,7 +53,7 @@ pub enum HilError {
     },
     /// A configuration file could not be parsed or validated.
     #[error(transparent)]
-    Config(#[from] crate::config::ConfigError),
+    Config(#[from] ConfigError),
     /// Reading or writing a file failed.
     #[error("{op} {}: {source}", path.display())]
     Io {
@@ -313,4 +313,71 @@ pub fn echo(value: &str) -> Cow<'_, str> {
         None => Cow::Borrowed(value),
         Some((cut, _)) => Cow::Owned(format!("{}… ({} bytes)", &value[..cut], value.len())),
     }
+}
+
+/// A configuration error, located in its file. `hil_config` finds the
+/// location (from the TOML parser and the field path).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}:{line}:{column}: {}{message}", path.display(), field.as_ref().map(|f| format!("field `{f}`: ")).unwrap_or_default())]
+pub struct ConfigError {
+    /// The file at fault.
+    pub path: PathBuf,
+    /// 1-based line (0 if unknown).
+    pub line: usize,
+    /// 1-based column (0 if unknown).
+    pub column: usize,
+    /// Dotted path of the field at fault, e.g. `policy.alpha`.
+    pub field: Option<String>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl ConfigError {
+    /// The error `message` about `field` at `line`:`column` of `path`
+    /// (0 where unknown). The field and any value the message quotes are
+    /// shortened by [`echo`], so a 100 KB key or value never becomes a
+    /// 100 KB message.
+    pub fn new(
+        path: &Path,
+        line: usize,
+        column: usize,
+        field: Option<String>,
+        message: &str,
+    ) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            line,
+            column,
+            field: field.map(|f| echo(&f).into_owned()),
+            message: echo_quoted(message),
+        }
+    }
+}
+
+/// `message` with every `` `quoted` `` or `"quoted"` part shortened by
+/// [`echo`]; a message still longer than a few values (unbalanced quotes) is
+/// shortened as a whole.
+fn echo_quoted(message: &str) -> String {
+    let mut out = String::with_capacity(message.len().min(1024));
+    let mut rest = message;
+    while let Some(open) = rest.find(['`', '"']) {
+        let quote = &rest[open..open + 1];
+        let Some(len) = rest[open + 1..].find(quote) else {
+            break;
+        };
+        let inner = &rest[open + 1..open + 1 + len];
+        out.push_str(&rest[..=open]);
+        out.push_str(&echo(inner));
+        out.push_str(quote);
+        rest = &rest[open + 2 + len..];
+    }
+    out.push_str(rest);
+    if out.chars().count() > 8 * ECHO_CHARS {
+        let cut = out
+            .char_indices()
+            .nth(8 * ECHO_CHARS)
+            .map_or(out.len(), |(i, _)| i);
+        out = format!("{}… ({} bytes)", &out[..cut], message.len());
+    }
+    out
 }

@@ -17,54 +17,53 @@
 //!   paper's metrics from those events.
 //! - The interaction record: [`record`] logs every step durably and
 //!   resumes killed sessions.
-//! - Configs: [`config::ExperimentConfig`], with errors naming file, line and field.
-//! - Plugins: [`plugin`] loads types from shared libraries ([`declare_plugin!`]).
-//! - Conformance suites for implementers: `hil_core::testing` (feature `testing`).
-// Only the plugin loader may use `unsafe` (it allows it locally).
+//! - Size-limited file reading ([`files`]) and [`ConfigError`], the located
+//!   error every config loader returns.
+//!
+//! Everything else has its own crate, each depending on this one:
+//! `hil-config` (component configs, build contexts, the limits every count
+//! is checked against, TOML error location),
+//! `hil-plugin` (plugins loaded from shared libraries, `declare_plugin!`),
+//! `hil-conformance` (the conformance suites for implementers),
+//! `hil-textdata` (CSV and line-table readers).
 #![deny(unsafe_code)]
 
 pub mod action;
 pub mod channel;
-pub mod config;
 pub mod context;
 pub mod decision;
 pub mod environment;
 pub mod error;
-pub mod experiment;
+pub mod event;
 pub mod files;
 pub mod metrics;
-pub mod plugin;
 pub mod policy;
 pub mod query;
 pub mod record;
 pub mod session;
-pub mod textdata;
 pub mod time;
 pub mod workload;
 
-#[cfg(feature = "testing")]
-pub mod testing;
-
 pub use action::{ActionSpace, ArmId};
 pub use channel::{PerfectExpert, QueryChannel};
-pub use config::{BuildContext, BuildMemo, ConfigError, ExperimentConfig, TaskContext};
-pub use context::Context;
+pub use context::{Context, Item};
 pub use decision::{
     ArmDiagnostics, Choice, Decision, Diagnostics, Extras, LabelledObservation, Outcome,
 };
-pub use environment::{CallOrder, Environment, Item};
-pub use error::{BoxError, HilError, Result};
-pub use experiment::{Experiment, ExperimentSummary};
+pub use environment::{CallOrder, Environment};
+pub use error::{BoxError, ConfigError, HilError, Result};
+pub use event::{PendingStep, StepDecision, StepEvent};
 pub use metrics::EpisodeMetrics;
 pub use policy::{DecisionInput, Feedback, Policy};
 pub use query::{
     Answer, BoundingBox, Difficulty, Distraction, Query, QueryKind, Response, ResponseType,
 };
-pub use session::{
-    EpisodeReport, EventCollector, PendingStep, Session, SessionObserver, SessionSettings,
-    StepDecision, StepEvent,
-};
+pub use session::{EpisodeReport, EventCollector, Session, SessionObserver, SessionSettings};
 pub use time::{TimeGrid, Timestep};
 pub use workload::{
     QueryHistory, QueryRecord, WorkloadForecast, WorkloadInput, WorkloadModel, WorkloadTracker,
 };
+
+/// The version of this crate, which a plugin's handshake compares with the
+/// host's (`hil_plugin::BuildFacts`).
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

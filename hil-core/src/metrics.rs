@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{HilError, Result};
-use crate::session::{StepDecision, StepEvent};
+use crate::event::{StepDecision, StepEvent};
 use crate::time::Timestep;
 use crate::workload::{QueryHistory, WorkloadModel, check_wl0, workload_at};
 
@@ -70,7 +70,7 @@ impl EpisodeMetrics {
     ///
     /// ```
     /// use hil_core::EpisodeMetrics;
-    /// use hil_core::testing::fixtures::CountingWorkload;
+    /// use hil_conformance::fixtures::CountingWorkload;
     /// let m = EpisodeMetrics::from_events(&[], 0.5, &CountingWorkload::new(0.1)).unwrap();
     /// assert_eq!(m.n_steps, 0);
     /// assert_eq!(m.delta_wl, 0.0);
@@ -148,7 +148,7 @@ impl EpisodeMetrics {
     ///
     /// ```
     /// use hil_core::EpisodeMetrics;
-    /// use hil_core::testing::fixtures::CountingWorkload;
+    /// use hil_conformance::fixtures::CountingWorkload;
     /// let m = EpisodeMetrics::from_events(&[], 0.5, &CountingWorkload::new(0.1)).unwrap();
     /// let r = m.rescored(&CountingWorkload::new(0.3)).unwrap();
     /// assert_eq!((r.r_task_avg, r.delta_wl), (m.r_task_avg, 0.0));

@@ -107,7 +107,7 @@ impl<'a> Feedback<'a> {
 /// Object-safe, no generics or associated types, so it can be named in
 /// configs through typetag and cross a plugin boundary.
 ///
-/// Contract (checked by `hil_core::testing::check_policy`):
+/// Contract (checked by `hil_conformance::check_policy`):
 /// - `decide` returns an arm in `0..n_arms()` (as `Act` or as a query's
 ///   `fallback`) and errors on a context of the wrong dimension;
 /// - given the same seed and inputs, a policy makes the same decisions;

@@ -7,8 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::action::{ActionSpace, ArmId};
-use crate::context::Context;
-use crate::environment::Item;
+use crate::context::{Context, Item};
 use crate::time::Timestep;
 
 /// How the person answers.

@@ -153,7 +153,7 @@ impl<'a> WorkloadInput<'a> {
 
 /// A model of querying workload: WL_t = f(WL_0, Q_t).
 ///
-/// Contract (checked by `hil_core::testing::check_workload_model`):
+/// Contract (checked by `hil_conformance::check_workload_model`):
 /// - predictions are finite for every WL_0 in [0, 1] and every history;
 /// - predictions are deterministic;
 /// - `predict_if_queried` equals `predict` on the history with the query appended.
@@ -266,7 +266,8 @@ impl<'a> WorkloadForecast<'a> {
 ///
 /// ```
 /// use hil_core::workload::workload_at;
-/// use hil_core::{QueryHistory, QueryKind, testing::fixtures::CountingWorkload};
+/// use hil_core::{QueryHistory, QueryKind};
+/// use hil_conformance::fixtures::CountingWorkload;
 /// let mut q = QueryHistory::new();
 /// q.push(3, QueryKind::default()).unwrap();
 /// let m = CountingWorkload::new(0.1);

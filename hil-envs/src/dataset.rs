@@ -287,7 +287,7 @@ impl FoodDataset {
             .map(Path::to_path_buf)
             .unwrap_or_default();
         let text = hil_core::files::read_text(&manifest_path, hil_core::files::limits::MANIFEST)?;
-        let m: Manifest = hil_core::config::parse_toml(&text, &manifest_path)?;
+        let m: Manifest = hil_config::parse_toml(&text, &manifest_path)?;
         let actions = ActionSpace::new(m.actions.clone())
             .map_err(|e| data_err(&manifest_path, 0, "actions", e.to_string()))?;
         let n_a = actions.len();

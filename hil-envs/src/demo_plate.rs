@@ -10,10 +10,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use hil_core::config::{EnvironmentConfig, limits};
+use hil_config::BuildContext;
+use hil_config::{EnvironmentConfig, limits};
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, CallOrder, Context, Environment, HilError, Item, Outcome,
-    Result,
+    ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, Outcome, Result,
 };
 
 use crate::feeding::{ALL_SETTINGS, FeedingTask, FoodFacts};
@@ -28,9 +28,9 @@ use crate::feeding::{ALL_SETTINGS, FeedingTask, FoodFacts};
 /// ```
 ///
 /// ```
-/// use hil_core::config::EnvironmentConfig;
+/// use hil_config::EnvironmentConfig;
 /// let cfg = hil_envs::demo_plate::DemoPlateConfig { foods: vec!["grape".into()], repeat: 2 };
-/// let env = cfg.build(&hil_core::BuildContext::new(".", 0))?;
+/// let env = cfg.build(&hil_config::BuildContext::new(".", 0))?;
 /// assert_eq!(env.name(), "demo_plate");
 /// # Ok::<(), hil_core::HilError>(())
 /// ```
@@ -224,7 +224,7 @@ impl Environment for DemoPlate {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hil_core::testing::check_environment;
+    use hil_conformance::check_environment;
 
     #[test]
     fn the_demo_plate_conforms() {

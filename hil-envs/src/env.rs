@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use hil_core::config::{BuildContext, EnvironmentConfig, limits};
+use hil_config::{BuildContext, EnvironmentConfig, limits};
 use hil_core::session::splitmix;
 use hil_core::{
     ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, LabelledObservation,

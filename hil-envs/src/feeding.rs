@@ -27,8 +27,8 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use hil_core::textdata::TextRecords;
 use hil_core::{ActionSpace, ArmId, HilError, Result};
+use hil_textdata::TextRecords;
 
 use crate::rates::{BUNDLED_RATES_CSV, POOLED, PublishedRates};
 

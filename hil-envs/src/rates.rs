@@ -17,7 +17,7 @@
 use std::path::Path;
 
 use hil_core::Result;
-use hil_core::textdata::TextRecords;
+use hil_textdata::TextRecords;
 
 /// The CSV compiled into the crate.
 pub const BUNDLED_RATES_CSV: &str = include_str!("../data/food_success_rates.csv");

@@ -12,7 +12,7 @@
 //! ```
 //! // A fresh program (each doctest is its own binary): no registration
 //! // call, only this crate's entry point.
-//! use hil_core::plugin::{ComponentKind, builtin_types};
+//! use hil_plugin::{ComponentKind, builtin_types};
 //! let text = r#"
 //! [environment]
 //! type = "demo_plate"
@@ -43,7 +43,8 @@
 
 use std::path::Path;
 
-use hil_core::{ConfigError, ExperimentConfig, Result};
+use crate::ExperimentConfig;
+use hil_core::{ConfigError, Result};
 
 // Naming each crate links it, and with it the types it registers.
 use hil_channels as _;

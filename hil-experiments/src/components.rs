@@ -21,7 +21,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use hil_core::config::{BuildContext, EnvironmentConfig, QueryChannelConfig, TaskContext};
+use hil_config::{BuildContext, EnvironmentConfig, QueryChannelConfig, TaskContext};
 use hil_core::{Environment, HilError, QueryChannel, Result};
 use hil_envs::{DatasetReplayEnv, FoodDataset};
 
@@ -139,10 +139,8 @@ impl ConfiguredChannel {
     }
 
     fn config(&self) -> Result<Box<dyn QueryChannelConfig>> {
-        hil_core::plugin::component::<_, dyn QueryChannelConfig>(toml::Value::Table(
-            self.table.clone(),
-        ))
-        .map_err(|e: toml::de::Error| self.invalid(e.message().trim()))
+        hil_plugin::component::<_, dyn QueryChannelConfig>(toml::Value::Table(self.table.clone()))
+            .map_err(|e: toml::de::Error| self.invalid(e.message().trim()))
     }
 
     fn invalid(&self, why: impl std::fmt::Display) -> HilError {
@@ -223,7 +221,7 @@ impl ConfiguredEnvironment {
         }
         let invalid =
             |why: String| HilError::invalid_parameter("environment", type_of(&self.table), why);
-        let config = hil_core::plugin::component::<_, dyn EnvironmentConfig>(toml::Value::Table(t))
+        let config = hil_plugin::component::<_, dyn EnvironmentConfig>(toml::Value::Table(t))
             .map_err(|e: toml::de::Error| invalid(e.message().trim().to_string()))?;
         config.validate().map_err(|e| invalid(e.to_string()))?;
         Ok(config)

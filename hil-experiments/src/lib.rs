@@ -5,6 +5,11 @@
 //! user-study protocol, aggregation with uncertainty, tables and figures, and
 //! the paper's published tables as data.
 //!
+//! - [`experiment_config`]: the experiment file, [`ExperimentConfig`]
+//!   (components named by type, built-in or from the plugins it lists);
+//!   [`experiment`]: the built [`Experiment`] run over its episodes;
+//!   [`recorded`]: [`run_recorded`], the run with its interaction record,
+//!   resumable from the log;
 //! - [`builtin`]: every built-in component type is linked into any
 //!   program using this crate; [`load_experiment`] reads a config with
 //!   all of them, with no registration call;
@@ -31,10 +36,13 @@ pub mod builtin;
 pub mod calibrate;
 pub mod claims;
 pub mod components;
+pub mod experiment;
+pub mod experiment_config;
 pub mod method;
 pub mod output;
 pub mod plot;
 pub mod published;
+pub mod recorded;
 pub mod report;
 pub mod results;
 pub mod testbed;
@@ -42,7 +50,10 @@ pub mod testbed;
 pub mod user_study;
 
 pub use builtin::{load_experiment, parse_experiment};
+pub use experiment::{Experiment, ExperimentSummary};
+pub use experiment_config::{ExperimentConfig, load_plugins};
 pub use method::Method;
+pub use recorded::run_recorded;
 pub use testbed::{NamedModel, Protocol, ProtocolSettings};
 #[cfg(feature = "physics")]
 pub use user_study::{UserStudy, UserStudyConfig, UserStudyResult};

@@ -12,7 +12,7 @@
 
 use std::collections::BTreeMap;
 
-use hil_core::config::PolicyConfig;
+use hil_config::PolicyConfig;
 use hil_core::{HilError, Result};
 use hil_paper::methods::PaperMethod;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -62,7 +62,7 @@ fn policy_table<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<toml::Ta
 
 /// The policy config a table describes.
 fn policy_config(table: &toml::Table) -> std::result::Result<Box<dyn PolicyConfig>, String> {
-    hil_core::plugin::component::<_, dyn PolicyConfig>(toml::Value::Table(table.clone()))
+    hil_plugin::component::<_, dyn PolicyConfig>(toml::Value::Table(table.clone()))
         .map_err(|e: toml::de::Error| e.message().trim().to_string())
 }
 

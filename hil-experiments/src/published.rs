@@ -20,7 +20,7 @@ use std::sync::OnceLock;
 use std::path::Path;
 
 use hil_core::Result;
-use hil_core::textdata::TextRecords;
+use hil_textdata::TextRecords;
 
 const BY_W_TASK: (&str, &str) = (
     "data/published/by_w_task.csv",

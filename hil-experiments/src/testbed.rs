@@ -1,15 +1,15 @@
 //! The paper's simulated-testbed protocol.
 //!
 //! 1. Split the foods (pretrain / validation / test, [`FoodSplit`]). Every
-//!    policy is built through its [`PolicyConfig`](hil_core::config::PolicyConfig) with a [`BuildContext`]
+//!    policy is built through its [`PolicyConfig`](hil_config::PolicyConfig) with a [`BuildContext`]
 //!    that offers the pretraining foods' (context, arm, reward) data, so a
 //!    config with `pretrain = true` starts from the pretrained estimator.
 //! 2. Run every (phase, method, grid value, seed[, policy seed][, deciding
 //!    workload model]) episode once, in parallel. What a method needs comes
 //!    from its config: one that does not read the workload forecast
-//!    ([`PolicyConfig::uses_workload_forecast`](hil_core::config::PolicyConfig::uses_workload_forecast)) runs once and is scored under
+//!    ([`PolicyConfig::uses_workload_forecast`](hil_config::PolicyConfig::uses_workload_forecast)) runs once and is scored under
 //!    every model; one that does runs once per deciding model; a stochastic
-//!    one ([`PolicyConfig::is_stochastic`](hil_core::config::PolicyConfig::is_stochastic)) runs under `n_policy_seeds`
+//!    one ([`PolicyConfig::is_stochastic`](hil_config::PolicyConfig::is_stochastic)) runs under `n_policy_seeds`
 //!    policy seeds. w_task never changes a run, only how it is scored.
 //! 3. For every scoring model and w_task, choose each tuned method's
 //!    hyperparameter maximising the mean M_wt over the validation runs,
@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use hil_core::config::{BuildContext, TaskContext, WorkloadModelConfig};
+use hil_config::{BuildContext, TaskContext, WorkloadModelConfig};
 use hil_core::session::{ComponentSeeds, splitmix};
 use hil_core::{
     EpisodeMetrics, HilError, Result, Session, SessionSettings, StepDecision, Timestep,
@@ -227,17 +227,17 @@ impl ProtocolSettings {
     /// name plugin policy types.
     pub fn load(path: &Path) -> Result<Self> {
         let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
-        hil_core::config::load_plugins(&text, path)?;
-        let mut s: Self = hil_core::config::parse_toml(&text, path)?;
+        crate::load_plugins(&text, path)?;
+        let mut s: Self = hil_config::parse_toml(&text, path)?;
         s.check_counts()
-            .map_err(|e| hil_core::ConfigError::from_error(&text, path, &[], e))?;
+            .map_err(|e| hil_config::error_in_section(&text, path, &[], e))?;
         // Paths in the file are relative to the file.
         let base = path.parent().unwrap_or(Path::new(""));
         if let Some(d) = &mut s.dataset {
             *d = base.join(&*d);
         }
         s.check_components()
-            .map_err(|e| hil_core::ConfigError::from_error(&text, path, &[], e))?;
+            .map_err(|e| hil_config::error_in_section(&text, path, &[], e))?;
         for m in &mut s.models {
             if let Some(f) = &mut m.file {
                 *f = base.join(&*f);
@@ -247,9 +247,9 @@ impl ProtocolSettings {
     }
 
     /// Checks every count against its stated limit
-    /// ([`hil_core::config::limits`]; seeds: at most [`MAX_SEEDS`]).
+    /// ([`hil_config::limits`]; seeds: at most [`MAX_SEEDS`]).
     pub fn check_counts(&self) -> Result<()> {
-        use hil_core::config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
+        use hil_config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
         check_count(
             "items_per_episode",
             self.items_per_episode,
@@ -537,7 +537,7 @@ impl ModelSource {
                 let invalid = |why: String| {
                     HilError::invalid_parameter(format!("models[{index}].config"), &self.name, why)
                 };
-                let config = hil_core::plugin::component::<_, dyn WorkloadModelConfig>(
+                let config = hil_plugin::component::<_, dyn WorkloadModelConfig>(
                     toml::Value::Table(t.clone()),
                 )
                 .map_err(|e: toml::de::Error| invalid(e.message().trim().to_string()))?;

@@ -18,7 +18,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use hil_core::config::{BuildContext, EnvironmentConfig};
+use hil_config::{BuildContext, EnvironmentConfig};
 use hil_core::{
     ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, LabelledObservation,
     Outcome, Result,
@@ -189,7 +189,7 @@ pub const MAX_PRETRAINING_TRIALS: u64 = 10_000;
 
 impl EnvironmentConfig for KinovaFeedingConfig {
     fn validate(&self) -> Result<()> {
-        use hil_core::config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
+        use hil_config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
         check_count("plate", self.plate.len(), ITEMS_PER_EPISODE)?;
         check_count("context_dim", self.context_dim, MAX_CONTEXT_DIM)?;
         check_at_most("settings", self.settings.len(), ITEMS_PER_EPISODE)?;

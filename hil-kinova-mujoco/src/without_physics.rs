@@ -3,7 +3,7 @@
 //! it fails with [`HilError::Unsupported`] saying how to enable MuJoCo,
 //! instead of an "unknown type" error that hides the cause.
 
-use hil_core::config::{BuildContext, EnvironmentConfig};
+use hil_config::{BuildContext, EnvironmentConfig};
 use hil_core::{Environment, HilError, Result};
 use serde::{Deserialize, Serialize};
 

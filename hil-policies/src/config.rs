@@ -23,7 +23,8 @@
 
 use std::fmt::Debug;
 
-use hil_core::{HilError, QueryKind, Result, TaskContext};
+use hil_config::TaskContext;
+use hil_core::{HilError, QueryKind, Result};
 use serde::de::{DeserializeOwned, Error as _};
 use serde::ser::Error as _;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -262,10 +263,10 @@ macro_rules! register {
     ($($fields:ty => $name:literal),+ $(,)?) => {
         $(
         #[typetag::serde(name = $name)]
-        impl hil_core::config::PolicyConfig for $crate::config::LinearPolicyConfig<$fields> {
+        impl hil_config::PolicyConfig for $crate::config::LinearPolicyConfig<$fields> {
             fn build(
                 &self,
-                ctx: &hil_core::TaskContext,
+                ctx: &hil_config::TaskContext,
             ) -> hil_core::Result<Box<dyn hil_core::Policy>> {
                 Ok(Box::new(self.build_policy(ctx)?))
             }

@@ -9,12 +9,12 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use hil_core::config::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
+use hil_config::{BuildContext, TaskContext};
+use hil_config::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Choice, Context, Decision, DecisionInput, Environment,
-    Feedback, HilError, Item, LabelledObservation, Outcome, Policy, Query, QueryChannel,
-    QueryHistory, QueryKind, Response, Result, TaskContext, Timestep, WorkloadForecast,
-    WorkloadInput, WorkloadModel,
+    ActionSpace, ArmId, Choice, Context, Decision, DecisionInput, Environment, Feedback, HilError,
+    Item, LabelledObservation, Outcome, Policy, Query, QueryChannel, QueryHistory, QueryKind,
+    Response, Result, Timestep, WorkloadForecast, WorkloadInput, WorkloadModel,
 };
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -49,10 +49,9 @@ macro_rules! parse_config {
                 .and_then(toml::Value::as_str)
                 .unwrap_or("?")
                 .to_string();
-            let cfg: Box<dyn $trait> =
-                hil_core::plugin::component(v).map_err(|e: toml::de::Error| {
-                    HilError::serde(format!("config of `{ty}`"), e.message().trim().to_string())
-                })?;
+            let cfg: Box<dyn $trait> = hil_plugin::component(v).map_err(|e: toml::de::Error| {
+                HilError::serde(format!("config of `{ty}`"), e.message().trim().to_string())
+            })?;
             cfg.validate()?;
             Ok(cfg)
         }

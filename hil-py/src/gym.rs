@@ -18,13 +18,14 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 
-use hil_core::config::{
+use hil_config::{BuildContext, TaskContext};
+use hil_config::{
     EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig, check_session_limits,
 };
 use hil_core::{
-    ArmId, BuildContext, Choice, Context, Decision, DecisionInput, Environment, EpisodeReport,
-    Feedback, HilError, Policy, QueryChannel, QueryHistory, QueryKind, Session, SessionObserver,
-    SessionSettings, StepEvent, TaskContext, Timestep, WorkloadForecast, WorkloadModel,
+    ArmId, Choice, Context, Decision, DecisionInput, Environment, EpisodeReport, Feedback,
+    HilError, Policy, QueryChannel, QueryHistory, QueryKind, Session, SessionObserver,
+    SessionSettings, StepEvent, Timestep, WorkloadForecast, WorkloadModel,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
@@ -48,11 +49,11 @@ struct GymConfig {
     build_seed: u64,
     #[serde(default)]
     session: SessionSettings,
-    #[serde(deserialize_with = "hil_core::plugin::component")]
+    #[serde(deserialize_with = "hil_plugin::component")]
     environment: Box<dyn EnvironmentConfig>,
-    #[serde(deserialize_with = "hil_core::plugin::component")]
+    #[serde(deserialize_with = "hil_plugin::component")]
     workload: Box<dyn WorkloadModelConfig>,
-    #[serde(deserialize_with = "hil_core::plugin::component")]
+    #[serde(deserialize_with = "hil_plugin::component")]
     channel: Box<dyn QueryChannelConfig>,
     /// What the "ask" action asks.
     #[serde(default)]

@@ -13,8 +13,9 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
-use hil_core::plugin::{ComponentKind, Params};
-use hil_core::{BuildContext, HilError, Result, TaskContext};
+use hil_config::{BuildContext, TaskContext};
+use hil_core::{HilError, Result};
+use hil_plugin::{ComponentKind, Params};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde_json::Value;
@@ -102,7 +103,7 @@ pub(crate) fn register_factory(kind: ComponentKind, name: &str, factory: Py<PyAn
     let label = format!("<python {kind} {name}>");
     let n = name.to_string();
     let desc = "a Python component (hil-py)";
-    hil_core::plugin::register_static(Path::new(&label), |r| match kind {
+    hil_plugin::register_static(Path::new(&label), |r| match kind {
         ComponentKind::Policy => r.policy(name, desc, move |p, ctx| {
             build(kind, &n, p, task_facts(ctx), policy_arg)
         }),

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use hil_core::HilError;
-use hil_core::plugin::ComponentKind;
 use hil_experiments::output::{Timing, report};
 use hil_experiments::testbed::{ModelSource, RunOutcome};
 use hil_experiments::{Method, Protocol, ProtocolSettings};
+use hil_plugin::ComponentKind;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use serde_json::Value;

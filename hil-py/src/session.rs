@@ -7,11 +7,11 @@
 
 use std::path::{Path, PathBuf};
 
-use hil_core::record::{Header, RecordLog, run_recorded};
-use hil_core::{
-    EventCollector, Experiment, ExperimentConfig, ExperimentSummary, HilError, SessionObserver,
-    SessionSettings,
-};
+use hil_core::record::{Header, RecordLog};
+use hil_core::{EventCollector, HilError, SessionObserver, SessionSettings};
+use hil_experiments::ExperimentConfig;
+use hil_experiments::run_recorded;
+use hil_experiments::{Experiment, ExperimentSummary};
 use pyo3::prelude::*;
 
 use crate::components::{channel_arg, environment_arg, policy_arg, workload_arg};

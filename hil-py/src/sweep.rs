@@ -11,7 +11,9 @@
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
-use hil_core::{ExperimentConfig, HilError, TaskContext};
+use hil_config::TaskContext;
+use hil_core::HilError;
+use hil_experiments::ExperimentConfig;
 use hil_experiments::testbed::{RunKey, RunOutcome, RunRecord};
 use hil_experiments::{Protocol, ProtocolSettings};
 use pyo3::prelude::*;

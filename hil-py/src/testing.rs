@@ -1,5 +1,5 @@
 //! hil's conformance suites from Python (`hil.testing.check_*`), wrapping
-//! `hil_core::testing::check_*_with`: the same checks every Rust and
+//! `hil_conformance::check_*_with`: the same checks every Rust and
 //! plugin implementation passes, run on Python components (or on hil's
 //! own, built by a Python factory).
 //!
@@ -7,7 +7,7 @@
 //! `factory(actions=[...], dim=..., seed=...)` for policies and query
 //! channels, `factory(seed=...)` for environments and workload models.
 
-use hil_core::testing::{
+use hil_conformance::{
     CheckOptions, ConformanceFailure, ConformanceReport, check_environment_with, check_policy_with,
     check_query_channel_with, check_workload_model_with,
 };

@@ -15,8 +15,9 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use hil_core::config::WorkloadModelConfig;
-use hil_core::{BuildContext, Result, WorkloadModel};
+use hil_config::BuildContext;
+use hil_config::WorkloadModelConfig;
+use hil_core::{Result, WorkloadModel};
 use serde::{Deserialize, Serialize};
 
 /// A model shipped with hil-workload (see [`crate::bundled`]).

@@ -8,9 +8,10 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use hil_config::BuildContext;
+use hil_config::{WorkloadModelConfig, limits};
 use hil_core::WorkloadInput;
-use hil_core::config::{WorkloadModelConfig, limits};
-use hil_core::{BuildContext, HilError, Result, WorkloadModel};
+use hil_core::{HilError, Result, WorkloadModel};
 
 /// Config of the demo workload model, `type = "demo_counting"`:
 ///
@@ -78,7 +79,7 @@ mod tests {
 
     #[test]
     fn the_demo_workload_conforms() {
-        hil_core::testing::check_workload_model(&DemoCounting {
+        hil_conformance::check_workload_model(&DemoCounting {
             increment: 0.05,
             window: 10,
         })

@@ -2,7 +2,7 @@
 //! loader whose errors name the file, line and column.
 //!
 //! The file is RFC 4180 CSV (read with the `csv` crate through
-//! [`hil_core::textdata::CsvFile`]): any field may be quoted, as spreadsheet
+//! [`hil_textdata::CsvFile`]): any field may be quoted, as spreadsheet
 //! programs write them, and a quoted field may hold commas. Blank lines and
 //! white space around fields are ignored; a UTF-8 byte-order mark is
 //! allowed. Files are read through [`hil_core::files`] and may hold at most
@@ -45,8 +45,8 @@
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
-use hil_core::textdata::{CsvFile, StringRecord, csv_line, data_error};
 use hil_core::{Difficulty, Distraction, HilError, QueryKind, ResponseType, Result};
+use hil_textdata::{CsvFile, StringRecord, csv_line, data_error};
 use serde::{Deserialize, Serialize};
 
 use crate::tlx::TlxAnswers;

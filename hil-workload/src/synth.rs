@@ -26,7 +26,7 @@
 //! any one generated study (the bundled one included) is one draw around
 //! them. See the crate README for the figures.
 
-use hil_core::config::limits;
+use hil_config::limits;
 use hil_core::{Difficulty, Distraction, ResponseType, Result};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};

@@ -6,14 +6,14 @@
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use hil_core::TaskContext;
-use hil_core::plugin::{self, Params};
-use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
-use hil_core::testing::fixtures::ScriptedPolicy;
+use hil_config::BuildContext;
+use hil_config::TaskContext;
+use hil_conformance::cdylib::{build_cdylibs, cdylib_path};
+use hil_conformance::fixtures::ScriptedPolicy;
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Choice, Context, DecisionInput, Policy, QueryHistory,
-    WorkloadForecast,
+    ActionSpace, ArmId, Choice, Context, DecisionInput, Policy, QueryHistory, WorkloadForecast,
 };
+use hil_plugin::{self as plugin, Params};
 
 fn input_for<'a>(x: &'a Context, h: &'a QueryHistory) -> DecisionInput<'a> {
     DecisionInput::new(x, 1, WorkloadForecast::none(h)).at_item(0, 0, 1)

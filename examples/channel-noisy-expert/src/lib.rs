@@ -8,8 +8,9 @@
 //! `response_time_s`, longer for hard questions.
 //!
 //! ```
-//! use hil_core::plugin::Params;
-//! use hil_core::{ActionSpace, BuildContext, TaskContext};
+//! use hil_plugin::Params;
+//! use hil_core::ActionSpace;
+//! use hil_config::{BuildContext, TaskContext};
 //! let ctx = TaskContext::new(BuildContext::new(".", 1), ActionSpace::new(["a", "b"]).unwrap(), 4);
 //! let ch = hil_example_channel_noisy_expert::build(
 //!     &Params::toml("error = 0.2\ndecline = 0.1"), &ctx).unwrap();
@@ -20,11 +21,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use hil_core::plugin::{Params, Registrar};
+use hil_config::TaskContext;
 use hil_core::{
     Answer, ArmId, Difficulty, Distraction, HilError, Query, QueryChannel, Response, Result,
-    TaskContext,
 };
+use hil_plugin::{Params, Registrar};
 
 /// The name the plugin registers.
 pub const NAME: &str = "noisy_expert";
@@ -144,7 +145,7 @@ pub fn register(r: &mut Registrar<'_>) {
     );
 }
 
-hil_core::declare_plugin!(register);
+hil_plugin::declare_plugin!(register);
 
 #[cfg(test)]
 mod tests {
@@ -152,16 +153,16 @@ mod tests {
 
     // One test per property; built through the factory, so seeded replay
     // is checked too.
-    hil_core::conformance_tests! {
+    hil_conformance::conformance_tests! {
         query_channel noisy_expert {
-            options: hil_core::testing::CheckOptions::default().with_queries(60),
+            options: hil_conformance::CheckOptions::default().with_queries(60),
             make: |opts| build(&Params::empty(), &opts.task_context()),
         }
     }
 
     #[test]
     fn rejects_bad_parameters() {
-        let ctx = hil_core::testing::CheckOptions::default().task_context();
+        let ctx = hil_conformance::CheckOptions::default().task_context();
         let e = build(&Params::toml("error = 1.5"), &ctx).err().unwrap();
         assert!(e.to_string().contains("`error`"), "{e}");
     }

@@ -14,8 +14,8 @@
 //! says `use hil_example_downstream_task as _;`, which links it).
 //!
 //! ```
-//! use hil_core::config::EnvironmentConfig;
-//! use hil_core::BuildContext;
+//! use hil_config::EnvironmentConfig;
+//! use hil_config::BuildContext;
 //! use hil_example_downstream_task as _;
 //! let cfg: Box<dyn EnvironmentConfig> = toml::from_str("type = \"cup_handover\"\nhandovers = 4").unwrap();
 //! let env = cfg.build(&BuildContext::new(".", 0)).unwrap();
@@ -26,10 +26,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use hil_core::config::EnvironmentConfig;
+use hil_config::BuildContext;
+use hil_config::EnvironmentConfig;
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, CallOrder, Context, Environment, HilError, Item, Outcome,
-    Result,
+    ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, Outcome, Result,
 };
 
 /// Handover poses, in arm order.
@@ -186,14 +186,14 @@ impl Environment for CupHandover {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy};
     use hil_core::channel::PerfectExpert;
-    use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy};
     use hil_core::{Choice, QueryKind, Session, SessionSettings};
     use std::sync::Arc;
 
     #[test]
     fn passes_the_environment_conformance_suite() {
-        hil_core::testing::check_environment(
+        hil_conformance::check_environment(
             &|| Ok(Box::new(CupHandover::new(6)?) as Box<dyn Environment>),
             3,
         )

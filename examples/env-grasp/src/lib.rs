@@ -9,8 +9,9 @@
 //! flat objects a pinch), not measured.
 //!
 //! ```
-//! use hil_core::plugin::Params;
-//! use hil_core::{BuildContext, Environment};
+//! use hil_plugin::Params;
+//! use hil_core::Environment;
+//! use hil_config::BuildContext;
 //! let mut env = hil_example_env_grasp::build(&Params::toml("n_objects = 3"), &BuildContext::new(".", 0)).unwrap();
 //! env.reset(1).unwrap();
 //! let item = env.next_item().unwrap().unwrap();
@@ -23,11 +24,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use hil_core::plugin::{Params, Registrar};
+use hil_config::BuildContext;
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, CallOrder, Context, Environment, HilError, Item, Outcome,
-    Result,
+    ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, Outcome, Result,
 };
+use hil_plugin::{Params, Registrar};
 
 /// The name the plugin registers.
 pub const NAME: &str = "grasp_choice";
@@ -232,16 +233,16 @@ pub fn register(r: &mut Registrar<'_>) {
     );
 }
 
-hil_core::declare_plugin!(register);
+hil_plugin::declare_plugin!(register);
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
     // One test per property.
-    hil_core::conformance_tests! {
+    hil_conformance::conformance_tests! {
         environment grasp_choice {
-            options: hil_core::testing::CheckOptions::default().with_attempts(3),
+            options: hil_conformance::CheckOptions::default().with_attempts(3),
             make: |opts| build(&Params::empty(), &opts.build_context()),
         }
     }

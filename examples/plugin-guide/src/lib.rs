@@ -8,11 +8,10 @@
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use hil_core::plugin::{Params, Registrar};
+use hil_config::TaskContext;
 use hil_core::policy::{check_feedback, check_input};
-use hil_core::{
-    ArmId, Decision, DecisionInput, Feedback, HilError, Policy, QueryKind, Result, TaskContext,
-};
+use hil_core::{ArmId, Decision, DecisionInput, Feedback, HilError, Policy, QueryKind, Result};
+use hil_plugin::{Params, Registrar};
 
 /// The parameters, as written in a config's `[policy]` section.
 #[derive(Debug, Deserialize)]
@@ -104,15 +103,15 @@ pub fn register(r: &mut Registrar<'_>) {
     );
 }
 
-hil_core::declare_plugin!(register);
+hil_plugin::declare_plugin!(register);
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hil_core::testing::CheckOptions;
+    use hil_conformance::CheckOptions;
 
     // One test per conformance property, named after it.
-    hil_core::conformance_tests! {
+    hil_conformance::conformance_tests! {
         policy ask_first_items {
             options: CheckOptions::default().with_context_dim(4),
             make: |opts| build(&Params::toml("n_ask = 2"), &opts.task_context()),

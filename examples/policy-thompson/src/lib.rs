@@ -16,8 +16,9 @@
 //! `linear_thompson`; as an `rlib` the same type can be linked statically.
 //!
 //! ```
-//! use hil_core::{ActionSpace, BuildContext, Policy, TaskContext};
-//! use hil_core::plugin::Params;
+//! use hil_core::{ActionSpace, Policy};
+//! use hil_config::{BuildContext, TaskContext};
+//! use hil_plugin::Params;
 //! let actions = ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap();
 //! let ctx = TaskContext::new(BuildContext::new(".", 7), actions, 4);
 //! let p = hil_example_policy_thompson::build(&Params::toml("confidence = 0.7"), &ctx).unwrap();
@@ -29,13 +30,13 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use hil_core::TaskContext;
-use hil_core::plugin::{Params, Registrar};
+use hil_config::TaskContext;
 use hil_core::policy::{check_feedback, check_input};
 use hil_core::{
     ArmDiagnostics, ArmId, Decision, DecisionInput, Diagnostics, Feedback, HilError, Policy,
     QueryKind, Result,
 };
+use hil_plugin::{Params, Registrar};
 
 /// The name the plugin registers.
 pub const NAME: &str = "linear_thompson";
@@ -334,7 +335,7 @@ pub fn register(r: &mut Registrar<'_>) {
     );
 }
 
-hil_core::declare_plugin!(register);
+hil_plugin::declare_plugin!(register);
 
 #[cfg(test)]
 mod tests {
@@ -343,23 +344,23 @@ mod tests {
 
     fn ctx() -> TaskContext {
         TaskContext::new(
-            hil_core::BuildContext::new(".", 3),
+            hil_config::BuildContext::new(".", 3),
             ActionSpace::new(["a", "b", "c", "d", "e", "f"]).unwrap(),
             5,
         )
     }
 
     // One test per property (checkpointing included: none is skipped).
-    hil_core::conformance_tests! {
+    hil_conformance::conformance_tests! {
         policy linear_thompson {
-            options: hil_core::testing::CheckOptions::default().with_context_dim(5),
+            options: hil_conformance::CheckOptions::default().with_context_dim(5),
             make: |opts| build(&Params::empty(), &opts.task_context()),
         }
     }
 
     #[test]
     fn passes_the_whole_policy_suite_without_skipping() {
-        let report = hil_core::testing::check_policy(&|| build(&Params::empty(), &ctx())).unwrap();
+        let report = hil_conformance::check_policy(&|| build(&Params::empty(), &ctx())).unwrap();
         assert!(report.skipped.is_empty(), "{report:?}");
     }
 

@@ -23,13 +23,14 @@
 
 use serde::{Deserialize, Serialize};
 
+use hil_config::BuildContext;
 use hil_core::WorkloadInput;
-use hil_core::plugin::{Params, Registrar};
 use hil_core::workload::check_wl0;
 use hil_core::{
-    BuildContext, Difficulty, Distraction, HilError, QueryHistory, QueryKind, ResponseType, Result,
-    Timestep, WorkloadModel,
+    Difficulty, Distraction, HilError, QueryHistory, QueryKind, ResponseType, Result, Timestep,
+    WorkloadModel,
 };
+use hil_plugin::{Params, Registrar};
 
 /// The name the plugin registers.
 pub const NAME: &str = "fatigue";
@@ -152,16 +153,16 @@ pub fn register(r: &mut Registrar<'_>) {
     );
 }
 
-hil_core::declare_plugin!(register);
+hil_plugin::declare_plugin!(register);
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
     // One test per property.
-    hil_core::conformance_tests! {
+    hil_conformance::conformance_tests! {
         workload_model fatigue {
-            options: hil_core::testing::CheckOptions::default(),
+            options: hil_conformance::CheckOptions::default(),
             make: |opts| build(&Params::empty(), &opts.build_context()),
         }
     }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use hil_core::config::{ConfigError, limits::check_seconds, parse_toml};
+use hil_config::{limits::check_seconds, parse_toml};
 use hil_core::{Difficulty, Distraction, HilError, ResponseType, Result};
 
 /// How conditions are ordered across participants.
@@ -204,7 +204,7 @@ impl StudyConfig {
             ("materials", c.materials.validate()),
         ] {
             if let Err(e) = check {
-                return Err(ConfigError::from_error(text, path, &[section], e).into());
+                return Err(hil_config::error_in_section(text, path, &[section], e).into());
             }
         }
         Ok(c)

@@ -46,7 +46,7 @@ pub fn export(dir: &Path) -> Result<Study> {
             ..
         }) = lines.first().map(|l| &l.event)
         else {
-            return Err(hil_core::textdata::data_error(
+            return Err(hil_textdata::data_error(
                 &path,
                 1,
                 "event",
@@ -77,7 +77,7 @@ pub fn export(dir: &Path) -> Result<Study> {
                     survey_time_s,
                 } => {
                     let Some((_, cond)) = design.condition(condition) else {
-                        return Err(hil_core::textdata::data_error(
+                        return Err(hil_textdata::data_error(
                             &path,
                             i + 1,
                             "condition",
@@ -89,7 +89,7 @@ pub fn export(dir: &Path) -> Result<Study> {
                             let Some(&(t, difficulty, response)) =
                                 shown.get(&(condition.clone(), *k))
                             else {
-                                return Err(hil_core::textdata::data_error(
+                                return Err(hil_textdata::data_error(
                                     &path,
                                     i + 1,
                                     "query",
@@ -109,7 +109,7 @@ pub fn export(dir: &Path) -> Result<Study> {
                         // End of a query condition: raw log only (see above).
                         (None, Some(_)) => continue,
                         (Some(_), None) => {
-                            return Err(hil_core::textdata::data_error(
+                            return Err(hil_textdata::data_error(
                                 &path,
                                 i + 1,
                                 "query",

@@ -131,10 +131,10 @@ pub fn read(path: &Path) -> Result<(Vec<Line>, usize)> {
     let mut lines = Vec::new();
     for (i, l) in text[..complete].lines().enumerate() {
         let line: Line = serde_json::from_str(l).map_err(|e| {
-            hil_core::textdata::data_error(path, i + 1, "event", format!("not a study event: {e}"))
+            hil_textdata::data_error(path, i + 1, "event", format!("not a study event: {e}"))
         })?;
         if line.seq != i {
-            return Err(hil_core::textdata::data_error(
+            return Err(hil_textdata::data_error(
                 path,
                 i + 1,
                 "seq",

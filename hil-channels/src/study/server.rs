@@ -68,7 +68,7 @@ impl Materials {
             if p.exists() {
                 passage = hil_core::files::read_text(&p, hil_core::files::limits::ASSET)?;
                 if passage.split_whitespace().count() < 10 {
-                    return Err(hil_core::textdata::data_error(
+                    return Err(hil_textdata::data_error(
                         &p,
                         1,
                         "passage",
@@ -164,7 +164,7 @@ pub fn stored_design(dir: &Path) -> Result<Option<DesignConfig>> {
     let text = hil_core::files::read_text(&p, hil_core::files::limits::CONFIG)?;
     serde_json::from_str(&text)
         .map(Some)
-        .map_err(|e| hil_core::textdata::data_error(&p, e.line(), "design", e.to_string()))
+        .map_err(|e| hil_textdata::data_error(&p, e.line(), "design", e.to_string()))
 }
 
 /// Every participant log in a data folder, in id order.

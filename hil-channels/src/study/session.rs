@@ -189,7 +189,7 @@ pub fn tally(
     lines: &[Line],
 ) -> Result<(usize, usize, usize)> {
     let Some(Event::Enrolled { order, .. }) = lines.first().map(|l| &l.event) else {
-        return Err(hil_core::textdata::data_error(
+        return Err(hil_textdata::data_error(
             path,
             1,
             "event",
@@ -200,7 +200,7 @@ pub fn tally(
         .iter()
         .map(|id| {
             design.condition(id).map(|(i, _)| i).ok_or_else(|| {
-                hil_core::textdata::data_error(
+                hil_textdata::data_error(
                     path,
                     1,
                     "order",
@@ -212,7 +212,7 @@ pub fn tally(
     let mut p = Progress::default();
     for l in &lines[1..] {
         p.apply(&order, design, &l.event)
-            .map_err(|why| hil_core::textdata::data_error(path, l.seq + 1, "event", why))?;
+            .map_err(|why| hil_textdata::data_error(path, l.seq + 1, "event", why))?;
     }
     Ok((p.surveys_total, p.pos.min(order.len()), order.len()))
 }
@@ -240,7 +240,7 @@ pub struct Participant {
 }
 
 fn line_error(log: &EventLog, seq: usize, why: String) -> HilError {
-    hil_core::textdata::data_error(log.path(), seq + 1, "event", why)
+    hil_textdata::data_error(log.path(), seq + 1, "event", why)
 }
 
 impl Participant {

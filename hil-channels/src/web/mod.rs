@@ -1,7 +1,7 @@
 //! A query channel served as a web page, for the person being fed: on a
 //! phone or tablet next to the robot, by touch, keyboard or single switch.
 
-use hil_core::TaskContext;
+use hil_config::TaskContext;
 pub(crate) mod http;
 pub mod urls;
 
@@ -13,7 +13,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
-use hil_core::config::QueryChannelConfig;
+use hil_config::QueryChannelConfig;
 use hil_core::{Answer, ArmId, HilError, Query, QueryChannel, Response, Result};
 
 use crate::present::{describe_item, describe_kind, question, validate_answer};
@@ -86,7 +86,7 @@ impl Default for WebChannelConfig {
 impl QueryChannelConfig for WebChannelConfig {
     fn validate(&self) -> Result<()> {
         // The rest (hosts, bind) needs the network stack: `start` checks it.
-        hil_core::config::limits::check_seconds("timeout_s", self.timeout_s)
+        hil_config::limits::check_seconds("timeout_s", self.timeout_s)
     }
 
     fn build(&self, ctx: &TaskContext) -> Result<Box<dyn QueryChannel>> {

@@ -1,14 +1,14 @@
 //! Simulated experts: conformance, rates, seeding and configs.
 
 use hil_channels::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
+use hil_config::BuildContext;
+use hil_config::QueryChannelConfig;
+use hil_config::TaskContext;
+use hil_conformance::check_query_channel;
 use hil_core::ActionSpace;
-use hil_core::TaskContext;
 use hil_core::channel::PerfectExpert;
-use hil_core::config::QueryChannelConfig;
-use hil_core::testing::check_query_channel;
 use hil_core::{
-    Answer, ArmId, BuildContext, Context, HilError, Item, Query, QueryChannel, QueryKind,
-    ResponseType,
+    Answer, ArmId, Context, HilError, Item, Query, QueryChannel, QueryKind, ResponseType,
 };
 
 fn query(t: u64, best: usize, response: ResponseType) -> Query {

@@ -2,7 +2,7 @@
 //! test in hil-cli drives it through a real pseudo-terminal).
 
 use hil_channels::TerminalChannel;
-use hil_core::testing::check_query_channel;
+use hil_conformance::check_query_channel;
 use hil_core::{
     Answer, ArmId, BoundingBox, Context, Difficulty, Distraction, Item, Query, QueryChannel,
     QueryKind, ResponseType,

@@ -11,7 +11,7 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 
 use hil_channels::{WebChannel, WebChannelConfig};
-use hil_core::testing::check_query_channel;
+use hil_conformance::check_query_channel;
 use hil_core::{Answer, ArmId, QueryChannel, ResponseType};
 use web_support::{ask_async, channel, get, open_id, post, query, raw, same_origin};
 

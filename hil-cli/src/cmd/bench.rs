@@ -12,7 +12,7 @@
 //! traffic (bytes per step, the bandwidth floor) is known only for the
 //! built-in estimator and is reported as absent for other policies.
 
-use hil_core::TaskContext;
+use hil_config::TaskContext;
 use hil_core::WorkloadInput;
 mod reproduce;
 mod spec;
@@ -21,9 +21,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
+use hil_config::BuildContext;
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Choice, Context, DecisionInput, Feedback, HilError,
-    LabelledObservation, QueryHistory, Result, Timestep, WorkloadForecast, WorkloadModel,
+    ActionSpace, ArmId, Choice, Context, DecisionInput, Feedback, HilError, LabelledObservation,
+    QueryHistory, Result, Timestep, WorkloadForecast, WorkloadModel,
 };
 use hil_policies::{EstimatorConfig, LinearArms, Representation};
 use hil_stats::{median, quantile};
@@ -171,7 +172,7 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         ));
     }
     for path in &a.plugins {
-        hil_core::plugin::load(path)?;
+        hil_plugin::load(path)?;
     }
     let spec = PolicySpec {
         policy: a.policy.clone(),

@@ -67,7 +67,7 @@ fn generate(a: GenerateArgs) -> hil_core::Result<()> {
     let mut g = match &a.generator {
         Some(p) => {
             let text = hil_core::files::read_text(p, hil_core::files::limits::CONFIG)?;
-            hil_core::config::parse_toml::<SyntheticFoods>(&text, p)?
+            hil_config::parse_toml::<SyntheticFoods>(&text, p)?
         }
         None => SyntheticFoods::default(),
     };

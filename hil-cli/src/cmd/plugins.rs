@@ -4,12 +4,12 @@
 
 use std::path::PathBuf;
 
-use hil_core::plugin::{self, BuildFacts, ComponentInfo, ComponentKind, Params, PluginInfo};
-use hil_core::testing::{
+use hil_conformance::{
     Check, CheckOptions, ConformanceFailure, ConformanceReport, check_environment_with,
     check_policy_with, check_query_channel_with, check_workload_model_with,
 };
 use hil_core::{ActionSpace, HilError};
+use hil_plugin::{self as plugin, BuildFacts, ComponentInfo, ComponentKind, Params, PluginInfo};
 
 /// Arguments of `hil plugins`.
 #[derive(Debug, clap::Args)]
@@ -338,7 +338,7 @@ fn check_one(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
+    use hil_conformance::cdylib::{build_cdylibs, cdylib_path};
 
     fn libs() -> PathBuf {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -4,8 +4,10 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use hil_core::record::{Header, RecordLog, run_recorded};
-use hil_core::{EpisodeMetrics, ExperimentSummary, HilError, SessionObserver, StepEvent};
+use hil_core::record::{Header, RecordLog};
+use hil_core::{EpisodeMetrics, HilError, SessionObserver, StepEvent};
+use hil_experiments::ExperimentSummary;
+use hil_experiments::run_recorded;
 
 /// Arguments of `hil run`.
 #[derive(Debug, clap::Args)]
@@ -72,7 +74,7 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
     let mut errors = result
         .err()
         .into_iter()
-        .chain(hil_core::plugin::take_destructor_panics());
+        .chain(hil_plugin::take_destructor_panics());
     let Some(first) = errors.next() else {
         return Ok(());
     };

@@ -6,7 +6,7 @@ use crate::common;
 use std::path::Path;
 
 use common::hil;
-use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
+use hil_conformance::cdylib::{build_cdylibs, cdylib_path};
 
 fn text(o: &std::process::Output) -> String {
     format!(

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
+use hil_conformance::cdylib::{build_cdylibs, cdylib_path};
 
 /// A short session that queries at every decision, through the channel
 /// whose `[channel]` table body is `channel`.

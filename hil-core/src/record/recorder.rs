@@ -39,7 +39,7 @@ impl Recorder {
 
     /// Continues `log`: `expected` records are verified rather than written,
     /// and `marker` is written before the first new record.
-    pub(crate) fn resuming(log: RecordLog, expected: Vec<LoggedRecord>, marker: Record) -> Self {
+    pub fn resuming(log: RecordLog, expected: Vec<LoggedRecord>, marker: Record) -> Self {
         Self {
             log,
             expected: expected.into(),
@@ -59,7 +59,7 @@ impl Recorder {
     }
 
     /// The first logged record not yet matched by the replay, if any.
-    pub(crate) fn next_expected(&self) -> Option<&LoggedRecord> {
+    pub fn next_expected(&self) -> Option<&LoggedRecord> {
         self.expected.front()
     }
 

@@ -9,16 +9,31 @@ use crate::query::{Query, Response};
 use crate::time::Timestep;
 
 /// A logged answer: episode, timestep, the response and its log line.
-pub(crate) type LoggedAnswer = (usize, Timestep, Response, usize);
+pub type LoggedAnswer = (usize, Timestep, Response, usize);
 
 /// Answers the queries a resumed session replays with the person's logged
 /// responses (a person must never be asked twice), then passes later
 /// queries to the live channel.
-pub(crate) struct ReplayChannel<'a> {
-    pub(crate) inner: &'a mut dyn QueryChannel,
-    pub(crate) logged: VecDeque<LoggedAnswer>,
-    pub(crate) episode: usize,
-    pub(crate) path: PathBuf,
+pub struct ReplayChannel<'a> {
+    /// The live channel, asked once the logged answers run out.
+    pub inner: &'a mut dyn QueryChannel,
+    /// The logged answers still to give, in order.
+    pub logged: VecDeque<LoggedAnswer>,
+    /// The episode being replayed (a logged answer must belong to it).
+    pub episode: usize,
+    /// The log's path, for errors.
+    pub path: PathBuf,
+}
+
+impl std::fmt::Debug for ReplayChannel<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ReplayChannel")
+            .field("inner", &self.inner.name())
+            .field("logged", &self.logged.len())
+            .field("episode", &self.episode)
+            .field("path", &self.path)
+            .finish()
+    }
 }
 
 impl QueryChannel for ReplayChannel<'_> {

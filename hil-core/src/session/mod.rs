@@ -16,7 +16,6 @@
 //!   [0, 1]. The error names the component and the field.
 
 mod checks;
-pub mod event;
 pub mod observer;
 
 use std::sync::Arc;
@@ -33,7 +32,7 @@ use crate::policy::{DecisionInput, Feedback, Policy};
 use crate::query::Query;
 use crate::workload::{DEFAULT_WL0, WorkloadForecast, WorkloadModel, WorkloadTracker, check_wl0};
 
-pub use event::{PendingStep, StepDecision, StepEvent};
+pub use crate::event::{self, PendingStep, StepDecision, StepEvent};
 pub use observer::{EventCollector, SessionObserver};
 
 /// The paper's attempt limit per item in simulation.
@@ -152,7 +151,7 @@ pub struct EpisodeReport {
 ///
 /// ```
 /// use std::sync::Arc;
-/// use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
+/// use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 /// use hil_core::{ActionSpace, ArmId, Choice, Environment, PerfectExpert, Session, SessionSettings};
 ///
 /// let actions = ActionSpace::new(["left", "right"]).unwrap();

@@ -1,9 +1,9 @@
 //! Extension hooks into the session loop, all no-ops by default.
 
-use crate::environment::Item;
+use crate::context::Item;
 use crate::error::Result;
+use crate::event::{PendingStep, StepEvent};
 use crate::metrics::EpisodeMetrics;
-use crate::session::event::{PendingStep, StepEvent};
 
 /// Receives the session's events as they happen. Every hook has a no-op
 /// default, so an observer implements only what it needs. An error from a

@@ -2,8 +2,8 @@
 //! reports [`HilError::Unsupported`] (the trait's default), and fails it
 //! for any other error, [`HilError::State`] included.
 
-use hil_core::testing::fixtures::ScriptedPolicy;
-use hil_core::testing::{Check, check_policy};
+use hil_conformance::fixtures::ScriptedPolicy;
+use hil_conformance::{Check, check_policy};
 use hil_core::{Decision, DecisionInput, Feedback, HilError, Policy, Result};
 
 /// The scripted fixture, with `save` either the trait's default or a

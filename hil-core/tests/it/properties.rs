@@ -4,8 +4,8 @@ use std::sync::Arc;
 
 use hil_core::channel::PerfectExpert;
 
-use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
-use hil_core::testing::strategies;
+use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
+use hil_conformance::strategies;
 use hil_core::{ActionSpace, ArmId, Choice, QueryKind, Session, SessionSettings, StepDecision};
 use proptest::prelude::*;
 

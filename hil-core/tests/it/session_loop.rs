@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use hil_core::channel::PerfectExpert;
 
-use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
+use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::{
     ActionSpace, Answer, ArmId, Choice, EpisodeReport, EventCollector, Query, QueryChannel,
     QueryKind, Response, Session, SessionObserver, SessionSettings, StepDecision,
@@ -288,7 +288,7 @@ fn shape_mismatch_is_an_error() {
 
 #[test]
 fn fixtures_pass_their_conformance_suites() {
-    use hil_core::testing::*;
+    use hil_conformance::*;
     let r = check_environment(
         &|| {
             Ok(Box::new(TableEnv::new(
@@ -315,7 +315,7 @@ fn fixtures_pass_their_conformance_suites() {
 
 #[test]
 fn conformance_catches_a_broken_environment() {
-    use hil_core::testing::check_environment;
+    use hil_conformance::check_environment;
     /// Replays differently on every reset: not seeded.
     struct Unseeded(TableEnv, u64);
     impl hil_core::Environment for Unseeded {
@@ -355,7 +355,7 @@ fn conformance_catches_a_broken_environment() {
         3,
     )
     .unwrap_err();
-    assert_eq!(err.check, hil_core::testing::Check::Replayable);
+    assert_eq!(err.check, hil_conformance::Check::Replayable);
 }
 
 /// A model whose workload decays: each query adds 0.3, forgotten 2 steps

@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 
 use crate::dataset::FoodDataset;
 use crate::npy::{NpyArray, read_npy_bytes, write_npy, write_npy_bytes};
+use hil_conformance::mutate::mutated;
 use hil_core::HilError;
-use hil_core::testing::mutate::mutated;
 use proptest::prelude::*;
 
 /// The file an error names, whatever its kind.
@@ -141,7 +141,7 @@ proptest! {
     #[test]
     fn a_dataset_with_a_mutated_array_is_read_or_refused_naming_that_array(
         which in proptest::sample::select(vec!["contexts", "success", "settings", "outcomes"]),
-        edits in proptest::collection::vec(hil_core::testing::mutate::mutation(), 1..4)
+        edits in proptest::collection::vec(hil_conformance::mutate::mutation(), 1..4)
     ) {
         let dir = fuzz_dir(&format!("array-{which}"));
         let manifest = write_dataset(&dir);

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use hil_core::testing::check_environment;
+use hil_conformance::check_environment;
 use hil_core::{ArmId, Environment};
 use hil_envs::dataset::FoodDataset;
 use hil_envs::generate::SyntheticFoods;
@@ -156,20 +156,20 @@ foods = ["banana", "carrot"]
 pretrain_foods = ["apple", "kiwi"]
 items_per_episode = 4
 "#;
-    let cfg: Box<dyn hil_core::config::EnvironmentConfig> = toml::from_str(text).unwrap();
-    let ctx = hil_core::BuildContext::new(".", 0);
+    let cfg: Box<dyn hil_config::EnvironmentConfig> = toml::from_str(text).unwrap();
+    let ctx = hil_config::BuildContext::new(".", 0);
     let env = cfg.build(&ctx).unwrap();
     assert_eq!(env.context_dim(), 2048);
     let pre = cfg.pretraining(&ctx).unwrap().unwrap();
     assert_eq!(pre.len(), 2 * 30 * 6);
-    let bad: Box<dyn hil_core::config::EnvironmentConfig> = toml::from_str(
+    let bad: Box<dyn hil_config::EnvironmentConfig> = toml::from_str(
         "type = \"food_replay\"\nfoods = [\"banana\"]\npretrain_foods = [\"banana\"]\n",
     )
     .unwrap();
     let e = bad.build(&ctx).err().unwrap().to_string();
     assert!(e.contains("banana") && e.contains("pretrain_foods"), "{e}");
     assert!(
-        toml::from_str::<Box<dyn hil_core::config::EnvironmentConfig>>(
+        toml::from_str::<Box<dyn hil_config::EnvironmentConfig>>(
             "type = \"food_replay\"\nfoods = [\"banana\"]\nfood = 1\n"
         )
         .is_err()

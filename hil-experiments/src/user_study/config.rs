@@ -4,12 +4,12 @@
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
-use hil_core::config::{
-    BuildContext, ConfigError, EnvironmentConfig, QueryChannelConfig, WorkloadModelConfig,
-    load_plugins, parse_toml,
+use hil_config::{
+    BuildContext, EnvironmentConfig, QueryChannelConfig, WorkloadModelConfig, parse_toml,
 };
-use hil_core::{HilError, Result, SessionSettings};
+use hil_core::{ConfigError, HilError, Result, SessionSettings};
 
+use crate::load_plugins;
 use crate::method::{Method, paper_policy};
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -58,21 +58,15 @@ pub struct UserStudyConfig {
     /// building it (e.g. simulating pretraining attempts) may be expensive.
     #[serde(
         default = "paper_environment",
-        deserialize_with = "hil_core::plugin::component"
+        deserialize_with = "hil_plugin::component"
     )]
     pub environment: Box<dyn EnvironmentConfig>,
     /// The workload model that evolves and scores the participant's
     /// workload, and that the policies forecast with.
-    #[serde(
-        default = "paper_workload",
-        deserialize_with = "hil_core::plugin::component"
-    )]
+    #[serde(default = "paper_workload", deserialize_with = "hil_plugin::component")]
     pub workload: Box<dyn WorkloadModelConfig>,
     /// Who answers queries; a fresh channel is built for every plate.
-    #[serde(
-        default = "paper_channel",
-        deserialize_with = "hil_core::plugin::component"
-    )]
+    #[serde(default = "paper_channel", deserialize_with = "hil_plugin::component")]
     pub channel: Box<dyn QueryChannelConfig>,
     /// The methods compared, in the order of the first repetition. A
     /// method may tune one hyperparameter (`tune = { w = [...] }`): the
@@ -245,10 +239,11 @@ impl UserStudyConfig {
     }
 
     fn validate_in(&self, text: &str, path: &Path) -> std::result::Result<(), ConfigError> {
-        let at = |key: &[&str], msg: &str| ConfigError::at_key(text, path, key, msg.to_string());
+        let at =
+            |key: &[&str], msg: &str| hil_config::error_at_key(text, path, key, msg.to_string());
         self.session
             .validate()
-            .map_err(|e| ConfigError::at_key(text, path, &["session"], e.to_string()))?;
+            .map_err(|e| hil_config::error_at_key(text, path, &["session"], e.to_string()))?;
         if self.repetitions == 0 {
             return Err(at(&["repetitions"], "must be at least 1"));
         }
@@ -307,7 +302,7 @@ impl UserStudyConfig {
 /// `index`-th `[[methods]]` entry's `label` when the file writes methods as
 /// an array of tables, else wherever [`ConfigError::at_key`] finds `label`.
 fn located_label(text: &str, path: &Path, index: usize, message: &str) -> ConfigError {
-    let mut err = ConfigError::at_key(text, path, &["methods", "label"], message.to_string());
+    let mut err = hil_config::error_at_key(text, path, &["methods", "label"], message.to_string());
     let mut entry = None;
     for (n, line) in text.lines().enumerate() {
         let l = line.trim_start();

@@ -4,10 +4,10 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
+use hil_config::TaskContext;
 use hil_core::session::splitmix;
 use hil_core::{
-    Environment, EpisodeReport, Policy, Result, Session, SessionObserver, TaskContext,
-    WorkloadModel,
+    Environment, EpisodeReport, Policy, Result, Session, SessionObserver, WorkloadModel,
 };
 use hil_stats::{Stat, mean};
 use serde::{Deserialize, Serialize};

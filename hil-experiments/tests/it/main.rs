@@ -1,7 +1,11 @@
 //! The integration tests of `hil-experiments`, linked into one test binary (one
 //! link instead of one per file); each module was a file of its own.
 
+mod experiment_config;
 mod protocol_components;
+mod record;
+mod record_fuzz;
+mod session_checks;
 mod testbed;
 #[cfg(feature = "physics")]
 mod user_study;

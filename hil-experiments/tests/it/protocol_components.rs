@@ -8,8 +8,9 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use hil_core::testing::fixtures::TableEnv;
-use hil_core::{ArmId, HilError, Query, QueryChannel, Response, TaskContext};
+use hil_config::TaskContext;
+use hil_conformance::fixtures::TableEnv;
+use hil_core::{ArmId, HilError, Query, QueryChannel, Response};
 use hil_envs::DatasetReplayEnv;
 use hil_experiments::components::{EnvironmentFactory, EpisodeSpec};
 use hil_experiments::testbed::{ModelSource, Phase, RunOutcome, RunRecord};

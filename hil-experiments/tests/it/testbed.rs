@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use hil_core::testing::fixtures::CountingWorkload;
+use hil_conformance::fixtures::CountingWorkload;
 use hil_envs::generate::SyntheticFoods;
 use hil_envs::{FoodDataset, FoodSplit};
 use hil_experiments::results::{Reproduction, Spread, aggregate};
@@ -278,11 +278,11 @@ fn paper_protocol_config_file_matches_the_built_in_settings() {
     );
     let text = std::fs::read_to_string(&path).unwrap();
     let bad = text.replace("n_seeds = 3", "n_seeds = 3\nn_seed = 2");
-    let e = hil_core::config::parse_toml::<ProtocolSettings>(&bad, &path).unwrap_err();
+    let e = hil_config::parse_toml::<ProtocolSettings>(&bad, &path).unwrap_err();
     assert_eq!(e.field.as_deref(), Some("n_seed"));
     // A method's policy table is checked as a policy config when parsed.
     let bad = text.replace("w = 1.0 }", "w = 1.0, omega = 2.0 }");
-    let e = hil_core::config::parse_toml::<ProtocolSettings>(&bad, &path).unwrap_err();
+    let e = hil_config::parse_toml::<ProtocolSettings>(&bad, &path).unwrap_err();
     assert!(e.message.contains("omega"), "{e}");
 }
 
@@ -350,7 +350,7 @@ type = "simulated_expert"
         pretrain = quote(&settings.split.pretrain),
     );
     let path = std::path::Path::new("episode.toml");
-    let cfg = hil_core::ExperimentConfig::parse(&text, path).unwrap();
+    let cfg = hil_experiments::ExperimentConfig::parse(&text, path).unwrap();
     let mut exp = cfg.build(std::path::Path::new(".")).unwrap();
     let (label, seeds) = p.seeds(&key);
     let report = hil_core::Session::new(

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use hil_core::config::ConfigError;
+use hil_core::ConfigError;
 use hil_core::{SessionObserver, StepEvent};
 use hil_experiments::user_study::{UserStudyConfig, method_order};
 

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
+use hil_conformance::cdylib::{build_cdylibs, cdylib_path};
 use hil_experiments::user_study::UserStudyConfig;
 
 #[test]

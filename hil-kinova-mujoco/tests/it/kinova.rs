@@ -4,9 +4,9 @@
 
 use std::sync::Arc;
 
+use hil_conformance::check_environment;
+use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy};
 use hil_core::channel::PerfectExpert;
-use hil_core::testing::check_environment;
-use hil_core::testing::fixtures::{CountingWorkload, ScriptedPolicy};
 use hil_core::{
     ArmId, Choice, Difficulty, Distraction, Environment, QueryKind, ResponseType, Session,
     SessionSettings,

@@ -10,8 +10,8 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use hil_core::TaskContext;
-use hil_core::config::PolicyConfig;
+use hil_config::PolicyConfig;
+use hil_config::TaskContext;
 use hil_core::policy::{check_feedback, check_input};
 use hil_core::{
     ArmDiagnostics, ArmId, Context, Decision, DecisionInput, Diagnostics, Feedback, HilError,
@@ -232,7 +232,7 @@ impl Policy for DemoLearner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hil_core::testing::check_policy;
+    use hil_conformance::check_policy;
 
     fn params(query_probability: f64, epsilon: f64) -> DemoLearnerConfig {
         DemoLearnerConfig {
@@ -250,7 +250,7 @@ mod tests {
     #[test]
     fn configs_are_checked() {
         let ctx = TaskContext::new(
-            hil_core::BuildContext::new(".", 0),
+            hil_config::BuildContext::new(".", 0),
             hil_core::ActionSpace::new(["a", "b"]).unwrap(),
             3,
         );

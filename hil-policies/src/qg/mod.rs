@@ -44,7 +44,7 @@ impl LinUcbQgParams {
 /// gap and it always acts.
 ///
 /// ```
-/// use hil_core::testing::fixtures::CountingWorkload;
+/// use hil_conformance::fixtures::CountingWorkload;
 /// use hil_core::{Choice, Context, DecisionInput, Policy, QueryHistory, QueryKind, WorkloadForecast};
 /// use hil_policies::{LinUcbQg, LinUcbQgParams, LinearArms};
 ///

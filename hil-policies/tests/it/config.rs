@@ -3,9 +3,11 @@
 
 use std::path::Path;
 
-use hil_core::TaskContext;
-use hil_core::config::{ConfigError, PolicyConfig, parse_toml};
-use hil_core::{ActionSpace, BuildContext, HilError, QueryKind};
+use hil_config::BuildContext;
+use hil_config::TaskContext;
+use hil_config::{PolicyConfig, parse_toml};
+use hil_core::ConfigError;
+use hil_core::{ActionSpace, HilError, QueryKind};
 use hil_policies::{LinUcbConfig, LinUcbExpDecayConfig, LinUcbQgConfig, POLICY_TYPES};
 
 #[derive(serde::Deserialize)]

@@ -4,10 +4,11 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use hil_core::TaskContext;
-use hil_core::config::PolicyConfig;
-use hil_core::testing::check_policy;
-use hil_core::{ActionSpace, ArmId, BuildContext, Context, LabelledObservation, Policy, QueryKind};
+use hil_config::BuildContext;
+use hil_config::PolicyConfig;
+use hil_config::TaskContext;
+use hil_conformance::check_policy;
+use hil_core::{ActionSpace, ArmId, Context, LabelledObservation, Policy, QueryKind};
 use hil_policies::{
     AlwaysQuery, AlwaysQueryParams, EstimatorOptions, LinUcb, LinUcbExpDecay, LinUcbExpDecayParams,
     LinUcbParams, LinUcbQg, LinUcbQgParams, LinearArms, RepresentationChoice,
@@ -78,11 +79,7 @@ fn conformance_suite_passes_for_every_policy_and_representation() {
         for make in all_policies(r) {
             let report = check_policy(&*make).unwrap_or_else(|e| panic!("{r:?}: {e}"));
             assert!(report.skipped.is_empty(), "{report:?}");
-            assert!(
-                report
-                    .passed
-                    .contains(&hil_core::testing::Check::Checkpoint)
-            );
+            assert!(report.passed.contains(&hil_conformance::Check::Checkpoint));
         }
     }
 }
@@ -106,8 +103,8 @@ fn ctx(pretrain: bool) -> TaskContext {
 }
 
 fn build(toml_text: &str, c: &TaskContext) -> Result<Box<dyn Policy>, String> {
-    let w: Wrapper = hil_core::config::parse_toml(toml_text, Path::new("test.toml"))
-        .map_err(|e| e.to_string())?;
+    let w: Wrapper =
+        hil_config::parse_toml(toml_text, Path::new("test.toml")).map_err(|e| e.to_string())?;
     w.policy.build(c).map_err(|e| e.to_string())
 }
 
@@ -137,7 +134,7 @@ fn configs_build_every_policy() {
 /// refused it: a parse error's field (under `policy.`), or an
 /// [`HilError::InvalidParameter`]'s name and value.
 fn refused_at(toml_text: &str, c: &TaskContext) -> (String, Option<String>) {
-    let w: Wrapper = match hil_core::config::parse_toml(toml_text, Path::new("test.toml")) {
+    let w: Wrapper = match hil_config::parse_toml(toml_text, Path::new("test.toml")) {
         Ok(w) => w,
         Err(e) => {
             let field = e.field.clone().unwrap_or_else(|| panic!("no field: {e}"));

@@ -3,8 +3,8 @@
 
 use std::sync::Arc;
 
+use hil_conformance::fixtures::{CountingWorkload, TableEnv};
 use hil_core::PerfectExpert;
-use hil_core::testing::fixtures::{CountingWorkload, TableEnv};
 use hil_core::{
     ActionSpace, ArmId, EpisodeReport, Policy, QueryKind, Session, SessionSettings, StepDecision,
 };

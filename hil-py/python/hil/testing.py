@@ -1,7 +1,7 @@
 """hil's conformance suites, run on Python components.
 
 The same checks every Rust and plugin implementation passes
-(``hil_core::testing``). Each returns a report dict (``subject``,
+(``hil_conformance``). Each returns a report dict (``subject``,
 ``passed``, ``skipped``) or raises :class:`hil.ConformanceError` whose
 ``check`` names the failed check and ``hint`` says the likely cause and fix.
 """

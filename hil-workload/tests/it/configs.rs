@@ -1,8 +1,9 @@
 //! The `bundled` and `model_file` workload-model configs.
 
+use hil_config::BuildContext;
+use hil_config::WorkloadModelConfig;
+use hil_core::QueryHistory;
 use hil_core::WorkloadInput;
-use hil_core::config::WorkloadModelConfig;
-use hil_core::{BuildContext, QueryHistory};
 
 fn parse(json: &str) -> Result<Box<dyn WorkloadModelConfig>, serde_json::Error> {
     serde_json::from_str(json)

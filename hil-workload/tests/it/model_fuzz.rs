@@ -5,8 +5,8 @@
 
 use std::path::Path;
 
+use hil_conformance::mutate::mutated;
 use hil_core::WorkloadInput;
-use hil_core::testing::mutate::mutated;
 use hil_core::{HilError, QueryHistory, QueryKind, WorkloadModel};
 use hil_workload::models::{
     AverageModel, ConstantModel, ExpImpulseModel, FittedModel, ModelSpec, Provenance,

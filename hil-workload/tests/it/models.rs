@@ -2,9 +2,9 @@
 //! monotonicity of the constrained variants, consistency of the fast
 //! cross-validation path with the models' own predictions.
 
+use hil_conformance::check_workload_model;
+use hil_conformance::strategies::{query_history, query_kind};
 use hil_core::WorkloadInput;
-use hil_core::testing::check_workload_model;
-use hil_core::testing::strategies::{query_history, query_kind};
 use hil_core::{HilError, QueryHistory, WorkloadModel};
 use hil_workload::datasets::{Dataset, DatasetId};
 use hil_workload::features::SparseRow;

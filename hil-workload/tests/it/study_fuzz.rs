@@ -6,8 +6,8 @@
 
 use std::path::Path;
 
+use hil_conformance::mutate::mutated;
 use hil_core::HilError;
-use hil_core::testing::mutate::mutated;
 use hil_workload::bundle::StudySummary;
 use hil_workload::datasets::{Dataset, DatasetId};
 use hil_workload::study::{Study, StudyRecord};

@@ -9,8 +9,8 @@
 
 use std::path::Path;
 
-use hil_core::ExperimentConfig;
 use hil_core::error::ECHO_CHARS;
+use hil_experiments::ExperimentConfig;
 use proptest::prelude::*;
 
 // Linked so that their component types are registered.

@@ -1,13 +1,14 @@
 //! Every count, size and window of an experiment config is checked against
-//! `hil_core::config::limits` when the file is loaded, and a bad parameter
+//! `hil_config::limits` when the file is loaded, and a bad parameter
 //! of any built-in component is a `ConfigError` naming the file, line and
 //! field, with the offending value shortened (issue 14, items 1 and 10).
 
 use std::path::Path;
 
-use hil_core::config::limits;
+use hil_config::limits;
 use hil_core::error::ECHO_CHARS;
-use hil_core::{ConfigError, ExperimentConfig, HilError};
+use hil_core::{ConfigError, HilError};
+use hil_experiments::ExperimentConfig;
 
 /// A valid experiment of demo components; `{episodes}` etc. are replaced.
 const DEMO: &str = r#"seed = 3

@@ -9,7 +9,7 @@ use crate::common;
 #[test]
 #[ignore = "e2e: needs a nested cargo test of a test plugin; bash scripts/test runs it"]
 fn a_policy_that_panics_on_a_longer_context_fails_exactly_its_generated_test() {
-    let (target, _) = hil_core::testing::cdylib::target_layout().unwrap();
+    let (target, _) = hil_conformance::cdylib::target_layout().unwrap();
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = std::process::Command::new(cargo)
         .current_dir(common::workspace_root())

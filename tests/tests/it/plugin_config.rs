@@ -5,7 +5,7 @@ use crate::common;
 
 use std::path::Path;
 
-use hil_core::ExperimentConfig;
+use hil_experiments::ExperimentConfig;
 
 fn so(krate: &str) -> String {
     common::lib(krate).display().to_string()

@@ -7,9 +7,10 @@
 
 use std::path::Path;
 
-use hil_core::plugin::{self, Params};
-use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
-use hil_core::{BuildContext, HilError};
+use hil_config::BuildContext;
+use hil_conformance::cdylib::{build_cdylibs, cdylib_path};
+use hil_core::HilError;
+use hil_plugin::{self as plugin, Params};
 
 #[test]
 #[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
@@ -20,7 +21,7 @@ fn every_kind_of_object_reports_a_destructor_panic_to_the_host() {
     plugin::load(&lib).unwrap();
     let ctx = BuildContext::new(".", 0);
     let actions = hil_core::ActionSpace::new(["a", "b"]).unwrap();
-    let task = hil_core::TaskContext::new(ctx.clone(), actions, 4);
+    let task = hil_config::TaskContext::new(ctx.clone(), actions, 4);
     let p = Params::toml("panic_in = \"drop\"");
     let _lock = crate::common::destructor_panics_lock();
     assert!(plugin::take_destructor_panics().is_empty());

@@ -2,13 +2,14 @@
 //! loading is idempotent.
 
 use crate::common;
-use hil_core::TaskContext;
+use hil_config::TaskContext;
 
 use std::path::Path;
 
 use common::{lib, scratch};
-use hil_core::plugin::{self, ComponentKind, Params};
-use hil_core::{ActionSpace, BuildContext, HilError};
+use hil_config::BuildContext;
+use hil_core::{ActionSpace, HilError};
+use hil_plugin::{self as plugin, ComponentKind, Params};
 
 fn ctx() -> BuildContext {
     BuildContext::new(".", 5)

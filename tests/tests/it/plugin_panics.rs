@@ -3,14 +3,15 @@
 //! next fallible call is an error), and the host process carries on.
 
 use crate::common;
-use hil_core::TaskContext;
+use hil_config::TaskContext;
 use hil_core::WorkloadInput;
 
-use hil_core::plugin::{self, Params};
+use hil_config::BuildContext;
 use hil_core::{
-    ActionSpace, ArmId, BuildContext, Context, DecisionInput, Feedback, HilError, Item, Policy,
-    Query, QueryHistory, QueryKind, WorkloadForecast,
+    ActionSpace, ArmId, Context, DecisionInput, Feedback, HilError, Item, Policy, Query,
+    QueryHistory, QueryKind, WorkloadForecast,
 };
+use hil_plugin::{self as plugin, Params};
 
 fn load() {
     plugin::load(&common::lib("hil-test-plugin-panicky")).unwrap();
@@ -108,7 +109,7 @@ fn policy_panics_are_errors() {
     // Dropping one that panics in its destructor does not take the host down.
     let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
-    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
+    assert_eq!(hil_plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
@@ -151,7 +152,7 @@ fn environment_panics_are_errors() {
     assert_eq!(e.action_space().len(), 2);
     let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
-    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
+    assert_eq!(hil_plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
@@ -176,7 +177,7 @@ fn workload_model_panics_are_errors() {
     );
     let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
-    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
+    assert_eq!(hil_plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]
@@ -204,7 +205,7 @@ fn query_channel_panics_are_errors() {
     assert_eq!(c.ask(&q).unwrap().expert_arm, Some(ArmId(0)));
     let _lock = common::destructor_panics_lock();
     drop(build("drop").unwrap());
-    assert_eq!(hil_core::plugin::take_destructor_panics().len(), 1);
+    assert_eq!(hil_plugin::take_destructor_panics().len(), 1);
 }
 
 #[test]

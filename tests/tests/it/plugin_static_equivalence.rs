@@ -3,14 +3,15 @@
 //! boundary both ways.
 
 use crate::common;
-use hil_core::TaskContext;
+use hil_config::TaskContext;
 
 use std::sync::Arc;
 
+use hil_config::BuildContext;
+use hil_conformance::fixtures::{CountingWorkload, TableEnv};
 use hil_core::channel::PerfectExpert;
-use hil_core::plugin::{self, Params};
-use hil_core::testing::fixtures::{CountingWorkload, TableEnv};
-use hil_core::{BuildContext, EpisodeReport, Policy, Session, SessionSettings};
+use hil_core::{EpisodeReport, Policy, Session, SessionSettings};
+use hil_plugin::{self as plugin, Params};
 
 const PARAMS: &str = "v = 0.4\nsamples = 12\nconfidence = 0.6\nmax_workload = 0.9";
 
@@ -89,14 +90,12 @@ fn static_and_plugin_policies_decide_identically() {
 #[ignore = "e2e: needs a nested cargo build of plugin libraries; bash scripts/test runs it"]
 fn the_static_policy_passes_its_conformance_suite_through_the_plugin_too() {
     plugin::load(&common::lib("hil-example-policy-thompson")).unwrap();
-    let report = hil_core::testing::check_policy(&|| {
+    let report = hil_conformance::check_policy(&|| {
         plugin::build_policy("linear_thompson", &Params::empty(), &ctx(6))
     })
     .unwrap();
     assert!(
-        report
-            .passed
-            .contains(&hil_core::testing::Check::Checkpoint),
+        report.passed.contains(&hil_conformance::Check::Checkpoint),
         "{report:?}"
     );
 }

@@ -6,8 +6,10 @@ use crate::common;
 
 use std::path::Path;
 
-use hil_core::plugin::{self, Params};
-use hil_core::{ActionSpace, BuildContext, ExperimentConfig, TaskContext};
+use hil_config::{BuildContext, TaskContext};
+use hil_core::ActionSpace;
+use hil_experiments::ExperimentConfig;
+use hil_plugin::{self as plugin, Params};
 
 fn guide() -> String {
     std::fs::read_to_string(common::workspace_root().join("PLUGINS.md")).unwrap()
@@ -72,7 +74,7 @@ fn the_guide_plugin_loads_conforms_and_runs_from_the_guide_config() {
         8,
     );
     let params = Params::toml("n_ask = 2");
-    hil_core::testing::check_policy(&|| plugin::build_policy("ask_first_items", &params, &ctx))
+    hil_conformance::check_policy(&|| plugin::build_policy("ask_first_items", &params, &ctx))
         .unwrap();
 
     // The guide's config, with the library where this build put it and the

@@ -21,7 +21,7 @@ pub struct ReproduceBench {
 }
 
 pub fn bench_reproduce(a: &ReproduceBench) -> Result<()> {
-    hil_core::config::limits::check_count("--runs", a.runs, 100)?;
+    hil_config::limits::check_count("--runs", a.runs, 100)?;
     let (pool, threads) = crate::cmd::worker_pool(a.threads)?;
     let mut wall = Vec::with_capacity(a.runs);
     let mut episodes = 0;

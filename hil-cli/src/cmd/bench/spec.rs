@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use hil_core::config::{PolicyConfig, parse_toml};
+use hil_config::{PolicyConfig, parse_toml};
 use hil_core::{HilError, Result};
 use hil_policies::POLICY_TYPES;
 
@@ -111,7 +111,7 @@ impl PolicySpec {
 pub(super) fn parse(table: &toml::Table) -> Result<Box<dyn PolicyConfig>> {
     #[derive(serde::Deserialize)]
     struct Wrapper {
-        #[serde(deserialize_with = "hil_core::plugin::component")]
+        #[serde(deserialize_with = "hil_plugin::component")]
         policy: Box<dyn PolicyConfig>,
     }
     let mut outer = toml::Table::new();

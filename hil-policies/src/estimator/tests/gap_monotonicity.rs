@@ -4,8 +4,8 @@ use crate::estimator::reference::NaiveArms;
 use crate::{
     EstimatorOptions, LinUcbQg, LinUcbQgParams, LinearArms, RepresentationChoice, query_gap,
 };
+use hil_conformance::strategies::context;
 use hil_core::WorkloadInput;
-use hil_core::testing::strategies::context;
 use hil_core::{
     ArmId, Choice, Context, DecisionInput, LabelledObservation, Policy, QueryHistory, QueryKind,
     Result, WorkloadForecast, WorkloadModel,

@@ -1,13 +1,13 @@
 //! A plugin claiming another hil-core version and other type layouts: hosts
 //! must refuse it, naming both sides' values of each.
 
-use hil_core::plugin::{ABI_VERSION, BuildFacts, FixedStr, Registrar};
+use hil_plugin::{ABI_VERSION, BuildFacts, FixedStr, Registrar};
 
 fn register(r: &mut Registrar<'_>) {
     r.workload_model("never_registered", "", |_, _| unreachable!());
 }
 
-hil_core::__declare_plugin_with!(
+hil_plugin::__declare_plugin_with!(
     register,
     ABI_VERSION,
     BuildFacts {

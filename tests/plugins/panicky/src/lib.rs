@@ -6,11 +6,11 @@ use serde::Deserialize;
 use serde_json::Value;
 
 use hil_core::WorkloadInput;
-use hil_core::plugin::{Params, Registrar};
 use hil_core::{
     ActionSpace, ArmId, Context, Decision, DecisionInput, Environment, Feedback, Item, Outcome,
     Policy, Query, QueryChannel, QueryKind, Response, Result, WorkloadModel,
 };
+use hil_plugin::{Params, Registrar};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -169,4 +169,4 @@ fn register(r: &mut Registrar<'_>) {
     });
 }
 
-hil_core::declare_plugin!(register);
+hil_plugin::declare_plugin!(register);

@@ -9,10 +9,9 @@
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use hil_core::plugin::{Params, Registrar};
-use hil_core::{
-    ArmId, Decision, DecisionInput, Feedback, HilError, Policy, QueryKind, Result, TaskContext,
-};
+use hil_config::TaskContext;
+use hil_core::{ArmId, Decision, DecisionInput, Feedback, HilError, Policy, QueryKind, Result};
+use hil_plugin::{Params, Registrar};
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct UncheckedLinear {
@@ -90,16 +89,16 @@ fn register(r: &mut Registrar<'_>) {
     );
 }
 
-hil_core::declare_plugin!(register);
+hil_plugin::declare_plugin!(register);
 
 /// One test per property; `rejects_wrong_dimension` fails by design, so
 /// they are compiled only with the `generated-tests` feature.
 #[cfg(all(test, feature = "generated-tests"))]
 mod tests {
     use super::*;
-    use hil_core::testing::CheckOptions;
+    use hil_conformance::CheckOptions;
 
-    hil_core::conformance_tests! {
+    hil_conformance::conformance_tests! {
         policy unchecked_linear {
             options: CheckOptions::default(),
             make: |opts| build(&Params::empty(), &opts.task_context()),

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use hil_core::testing::cdylib::{build_cdylibs, cdylib_path};
+use hil_conformance::cdylib::{build_cdylibs, cdylib_path};
 
 /// Every plugin crate the integration tests load.
 pub const PLUGIN_CRATES: [&str; 9] = [

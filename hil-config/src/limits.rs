@@ -1,0 +1,127 @@
+//! The limits every count, size and window in a config is checked against
+//! when the config is loaded, defined once so that documentation can quote
+//! them and every component crate checks the same numbers.
+//!
+//! A count outside its limit is refused before anything proportional to it
+//! is allocated: an `episodes = 9223372036854775807` or a demo plate's
+//! `repeat = 4294967296` is a located config error, not an allocation
+//! failure. The limits are far above anything the paper's protocols or a
+//! real session use, and low enough that a run at the limit fits in memory.
+//!
+//! | limit | value | applies to |
+//! |---|---|---|
+//! | [`EPISODES`] | 100 000 | `episodes` of an experiment |
+//! | [`ITEMS_PER_EPISODE`] | 100 000 | `items_per_episode`, `session.max_items`, a demo plate's `foods` × `repeat` |
+//! | [`ATTEMPTS_PER_ITEM`] | 1 000 | `session.n_att` |
+//! | [`WINDOW`] | 1 000 000 | a workload model's `window` (timesteps) |
+//! | [`PARTICIPANTS`] | 10 000 | each participant count of a synthetic study |
+//! | [`SURVEYS`] | 1 000 000 | a count of surveys of a synthetic study |
+//! | [`SECONDS`] | 86 400 | a simulated time in seconds (a day) |
+//!
+//! Component crates call [`check_count`] (a count that must be at least 1)
+//! or [`check_at_most`] (one that may be 0) from their config's
+//! `validate`, which the loader runs, so the error names the file, line and
+//! field:
+//!
+//! ```
+//! use hil_config::limits::{self, check_count};
+//! use hil_core::HilError;
+//! assert!(check_count("repeat", 3usize, limits::ITEMS_PER_EPISODE).is_ok());
+//! let err = check_count("repeat", 4_294_967_296u64, limits::ITEMS_PER_EPISODE).unwrap_err();
+//! assert!(matches!(err, HilError::InvalidParameter { ref name, .. } if name == "repeat"));
+//! assert!(check_count("repeat", 0u32, limits::ITEMS_PER_EPISODE).is_err());
+//! ```
+
+use hil_core::{HilError, Result};
+
+/// Most episodes one experiment runs.
+pub const EPISODES: u64 = 100_000;
+
+/// Most items one episode presents (`items_per_episode`,
+/// `session.max_items`, a demo plate's foods × `repeat`).
+pub const ITEMS_PER_EPISODE: u64 = 100_000;
+
+/// Most attempts per item (`session.n_att`, the paper's N_att = 10).
+pub const ATTEMPTS_PER_ITEM: u64 = 1_000;
+
+/// Longest window, in timesteps, over which a workload model counts queries.
+pub const WINDOW: u64 = 1_000_000;
+
+/// Most participants in each group of a synthetic study.
+pub const PARTICIPANTS: u64 = 10_000;
+
+/// Most surveys a synthetic study counts (e.g. its missing surveys).
+pub const SURVEYS: u64 = 1_000_000;
+
+/// Longest simulated duration in seconds (one day), e.g. a simulated
+/// expert's median response time.
+pub const SECONDS: f64 = 86_400.0;
+
+/// Checks that the count `value` of the field `name` is in `1..=max`.
+///
+/// The error is [`HilError::InvalidParameter`] naming `name`; a config
+/// loader turns it into a [`super::ConfigError`] naming the file, line and
+/// field.
+pub fn check_count<T>(name: &str, value: T, max: u64) -> Result<()>
+where
+    T: TryInto<u64> + std::fmt::Display + Copy,
+{
+    in_range(name, value, 1, max)
+}
+
+/// Checks that the size `value` of the field `name` is in `0..=max`.
+pub fn check_at_most<T>(name: &str, value: T, max: u64) -> Result<()>
+where
+    T: TryInto<u64> + std::fmt::Display + Copy,
+{
+    in_range(name, value, 0, max)
+}
+
+fn in_range<T>(name: &str, value: T, min: u64, max: u64) -> Result<()>
+where
+    T: TryInto<u64> + std::fmt::Display + Copy,
+{
+    // A value that does not fit in u64 (a negative number) is out of range.
+    match value.try_into() {
+        Ok(v) if (min..=max).contains(&v) => Ok(()),
+        _ => Err(HilError::invalid_parameter(
+            name,
+            value,
+            format!("must be between {min} and {max}"),
+        )),
+    }
+}
+
+/// Checks that the duration `value` (seconds) of the field `name` is finite,
+/// positive and at most [`SECONDS`].
+pub fn check_seconds(name: &str, value: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 && value <= SECONDS {
+        Ok(())
+    } else {
+        Err(HilError::invalid_parameter(
+            name,
+            value,
+            format!("must be a number of seconds in (0, {SECONDS}]"),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_are_inclusive() {
+        assert!(check_count("n", 1u32, 5).is_ok());
+        assert!(check_count("n", 5usize, 5).is_ok());
+        assert!(check_count("n", 6usize, 5).is_err());
+        assert!(check_count("n", 0usize, 5).is_err());
+        assert!(check_at_most("n", 0usize, 5).is_ok());
+        assert!(check_at_most("n", -1i64, 5).is_err());
+        assert!(check_at_most("n", usize::MAX, 5).is_err());
+        assert!(check_seconds("t", SECONDS).is_ok());
+        for bad in [0.0, -1.0, f64::INFINITY, f64::NAN, SECONDS * 2.0] {
+            assert!(check_seconds("t", bad).is_err(), "{bad}");
+        }
+    }
+}

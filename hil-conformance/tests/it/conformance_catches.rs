@@ -1,0 +1,234 @@
+//! Every conformance check can fail: each deliberately broken
+//! implementation of `hil_conformance::broken` is caught by exactly the
+//! check its defect names, both by the whole suite and by that property
+//! run alone; the unbroken implementations pass; and the tests generated
+//! by `conformance_tests!` fail naming the property.
+
+use std::collections::HashSet;
+
+use hil_conformance::broken::{
+    self, ChannelDefect, EnvironmentDefect, PolicyDefect, WorkloadDefect,
+};
+use hil_conformance::{
+    Check, CheckOptions, ConformanceFailure, ConformanceReport, Subject, assert_conforms,
+    check_environment_only, check_environment_with, check_policy_only, check_policy_with,
+    check_query_channel_only, check_query_channel_with, check_workload_model_only,
+    check_workload_model_with,
+};
+use hil_core::HilError;
+
+/// Three actions, so a channel that assumes the feeding task's six is caught.
+fn options() -> CheckOptions {
+    CheckOptions::default()
+        .with_actions(hil_core::ActionSpace::new(["grasp", "push", "lift"]).unwrap())
+        .with_context_dim(4)
+}
+
+type Run = Result<ConformanceReport, ConformanceFailure>;
+
+/// A suite run, whole (`None`) or of one property.
+type Runner<'a> = &'a dyn Fn(Option<Check>) -> Run;
+
+fn policy_runs(d: Option<PolicyDefect>, only: Option<Check>) -> Run {
+    let opts = options();
+    let make = || broken::policy(d, &opts);
+    match only {
+        None => check_policy_with(&make, &opts),
+        Some(p) => check_policy_only(&make, &opts, p),
+    }
+}
+
+fn environment_runs(d: Option<EnvironmentDefect>, only: Option<Check>) -> Run {
+    let opts = options();
+    let make = || broken::environment(d);
+    match only {
+        None => check_environment_with(&make, &opts),
+        Some(p) => check_environment_only(&make, &opts, p),
+    }
+}
+
+fn workload_runs(d: Option<WorkloadDefect>, only: Option<Check>) -> Run {
+    let opts = options();
+    let m = broken::workload_model(d).unwrap();
+    match only {
+        None => check_workload_model_with(m.as_ref(), &opts),
+        Some(p) => check_workload_model_only(m.as_ref(), &opts, p),
+    }
+}
+
+fn channel_runs(d: Option<ChannelDefect>, only: Option<Check>) -> Run {
+    let opts = options();
+    let make = || broken::query_channel(d);
+    match only {
+        None => check_query_channel_with(&make, &opts),
+        Some(p) => check_query_channel_only(&make, &opts, p),
+    }
+}
+
+/// The suite, and the broken property alone, fail with the defect's check.
+fn assert_caught(what: &str, breaks: Check, run: impl Fn(Option<Check>) -> Run) {
+    let e = run(None).expect_err(what);
+    assert_eq!(
+        e.check, breaks,
+        "{what}: the whole suite failed another check: {e}"
+    );
+    if !breaks.is_prerequisite() {
+        let e = run(Some(breaks)).expect_err(what);
+        assert_eq!(
+            e.check, breaks,
+            "{what}: the property alone failed another check: {e}"
+        );
+    }
+}
+
+#[test]
+fn every_broken_policy_fails_its_check() {
+    for &d in PolicyDefect::ALL {
+        assert_caught(&format!("{d:?}"), d.breaks(), |only| {
+            policy_runs(Some(d), only)
+        });
+    }
+}
+
+#[test]
+fn every_broken_environment_fails_its_check() {
+    for &d in EnvironmentDefect::ALL {
+        assert_caught(&format!("{d:?}"), d.breaks(), |only| {
+            environment_runs(Some(d), only)
+        });
+    }
+}
+
+#[test]
+fn every_broken_workload_model_fails_its_check() {
+    for &d in WorkloadDefect::ALL {
+        assert_caught(&format!("{d:?}"), d.breaks(), |only| {
+            workload_runs(Some(d), only)
+        });
+    }
+}
+
+#[test]
+fn every_broken_channel_fails_its_check() {
+    for &d in ChannelDefect::ALL {
+        assert_caught(&format!("{d:?}"), d.breaks(), |only| {
+            channel_runs(Some(d), only)
+        });
+    }
+}
+
+#[test]
+fn every_check_has_a_broken_implementation() {
+    let covered: HashSet<Check> = PolicyDefect::ALL
+        .iter()
+        .map(|d| d.breaks())
+        .chain(EnvironmentDefect::ALL.iter().map(|d| d.breaks()))
+        .chain(WorkloadDefect::ALL.iter().map(|d| d.breaks()))
+        .chain(ChannelDefect::ALL.iter().map(|d| d.breaks()))
+        .collect();
+    let missing: Vec<&Check> = Check::ALL.iter().filter(|c| !covered.contains(c)).collect();
+    assert!(
+        missing.is_empty(),
+        "checks without a broken implementation: {missing:?}"
+    );
+}
+
+#[test]
+fn the_unbroken_implementations_pass_every_property() {
+    let subjects: [(Subject, Runner<'_>); 4] = [
+        (Subject::Policy, &|only| policy_runs(None, only)),
+        (Subject::Environment, &|only| environment_runs(None, only)),
+        (Subject::WorkloadModel, &|only| workload_runs(None, only)),
+        (Subject::QueryChannel, &|only| channel_runs(None, only)),
+    ];
+    for (subject, run) in subjects {
+        let report = run(None).unwrap_or_else(|e| panic!("{subject:?}: {e}"));
+        assert!(
+            report.skipped.is_empty(),
+            "{subject:?}: {:?}",
+            report.skipped
+        );
+        for p in Check::properties(subject) {
+            assert!(report.passed.contains(&p), "{subject:?}: {p} not exercised");
+            assert_conforms(run(Some(p)), p);
+        }
+    }
+}
+
+#[test]
+fn a_guarded_panic_is_a_failure_never_a_refusal() {
+    let opts = options();
+    // Through the guard, a longer context is a HilError::Plugin ...
+    let mut p = broken::policy(Some(PolicyDefect::PanicsOnLongerContext), &opts).unwrap();
+    let x = hil_core::Context::new(vec![0.0; 5]).unwrap();
+    let history = hil_core::QueryHistory::new();
+    let input = hil_core::DecisionInput::new(
+        &x,
+        1,
+        hil_core::WorkloadForecast::new(Some(opts.workload()), 0.5, &history, 1),
+    );
+    assert!(matches!(p.decide(&input), Err(HilError::Plugin { .. })));
+    // ... which the suite does not count as rejecting the wrong dimension.
+    let e = policy_runs(Some(PolicyDefect::PanicsOnLongerContext), None).unwrap_err();
+    assert_eq!(e.check, Check::RejectsWrongDimension);
+    // A panicking save is a checkpoint failure, not "skipped".
+    let e = policy_runs(Some(PolicyDefect::PanicsInSave), None).unwrap_err();
+    assert_eq!(e.check, Check::Checkpoint);
+}
+
+#[test]
+fn a_channel_assuming_six_actions_passes_only_over_six() {
+    let six = CheckOptions::default();
+    let make = || broken::query_channel(Some(ChannelDefect::AssumesSixActions));
+    check_query_channel_with(&make, &six).unwrap();
+    let e = check_query_channel_with(&make, &options()).unwrap_err();
+    assert_eq!(e.check, Check::ExpertArmInRange);
+}
+
+#[test]
+fn a_generated_test_fails_naming_its_property() {
+    let r = policy_runs(
+        Some(PolicyDefect::PanicsOnLongerContext),
+        Some(Check::RejectsWrongDimension),
+    );
+    let panic = std::panic::catch_unwind(|| assert_conforms(r, Check::RejectsWrongDimension))
+        .expect_err("the property fails");
+    let message = panic.downcast_ref::<String>().cloned().unwrap_or_default();
+    assert!(
+        message.starts_with("property `rejects wrong dimension` does not hold for `broken_policy`"),
+        "{message}"
+    );
+    // The policy's other properties still hold.
+    for p in [Check::Determinism, Check::Checkpoint, Check::ArmInRange] {
+        assert_conforms(
+            policy_runs(Some(PolicyDefect::PanicsOnLongerContext), Some(p)),
+            p,
+        );
+    }
+}
+
+// The generated tests themselves, for the conforming implementations.
+hil_conformance::conformance_tests! {
+    policy generated_policy {
+        options: options(),
+        make: |opts| broken::policy(None, opts),
+    }
+}
+hil_conformance::conformance_tests! {
+    environment generated_environment {
+        options: options(),
+        make: |_opts| broken::environment(None),
+    }
+}
+hil_conformance::conformance_tests! {
+    workload_model generated_workload_model {
+        options: options(),
+        make: |_opts| broken::workload_model(None),
+    }
+}
+hil_conformance::conformance_tests! {
+    query_channel generated_query_channel {
+        options: options(),
+        make: |_opts| broken::query_channel(None),
+    }
+}

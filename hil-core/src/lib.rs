@@ -58,7 +58,9 @@ pub use policy::{DecisionInput, Feedback, Policy};
 pub use query::{
     Answer, BoundingBox, Difficulty, Distraction, Query, QueryKind, Response, ResponseType,
 };
-pub use session::{EpisodeReport, EventCollector, Session, SessionObserver, SessionSettings};
+pub use session::{
+    Episode, EpisodeReport, EventCollector, Session, SessionObserver, SessionSettings,
+};
 pub use time::{TimeGrid, Timestep};
 pub use workload::{
     QueryHistory, QueryRecord, WorkloadForecast, WorkloadInput, WorkloadModel, WorkloadTracker,

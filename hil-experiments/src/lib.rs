@@ -24,6 +24,8 @@
 //!   in counterbalanced order, per-plate results, mean ± standard error),
 //!   in the MuJoCo scene, so only with the crate feature `physics` (run
 //!   `scripts/setup-mujoco` first);
+//! - [`run`]: running an experiment file with its interaction record, and
+//!   resuming one from its log (what `hil run` and hil-py's `hil.run` do);
 //! - [`results`]: selection and aggregation; [`report`]: Markdown tables
 //!   beside the paper's published numbers ([`published`], read from data
 //!   files); [`plot`]: SVG figures; [`output`]: writes them all.
@@ -45,6 +47,7 @@ pub mod published;
 pub mod recorded;
 pub mod report;
 pub mod results;
+pub mod run;
 pub mod testbed;
 #[cfg(feature = "physics")]
 pub mod user_study;

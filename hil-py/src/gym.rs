@@ -1,31 +1,26 @@
 //! Native engine of `hil.envs`: hil's session loop driven one decision at a
 //! time by a Gymnasium agent, which may be a `hil.Policy` (`act` / `learn`).
 //!
-//! A Gymnasium environment hands control to the agent at every step, while
-//! hil's [`Session`] owns its loop. Rather than re-implementing the loop
-//! (items, attempts, following the expert after a query, the workload
-//! tracker, the checks), the episode runs the real `Session::run_episode` on
-//! a worker thread whose policy is a remote: each `Policy::decide` sends the
-//! decision input to [`GymCore`] and blocks until the agent's action comes
-//! back. So a Gymnasium step is exactly one decision of the policy, followed
-//! by every attempt the session executes before it asks the policy again
-//! (one attempt after an autonomous action; after a query, the expert's arm
-//! repeated until success or `n_att`). Abandoning an episode (a new `reset`,
-//! or dropping the environment) disconnects the remote, whose next `decide`
-//! fails, which ends the worker's session.
+//! The engine drives the steppable session ([`hil_core::session::step`]) on
+//! the caller's thread: `reset` starts an episode and moves it to the first
+//! decision ([`Session::next_decision`]); `step` feeds the agent's action
+//! ([`Session::feed_decision`]) and moves on to the next decision. So a
+//! Gymnasium step is exactly one decision of the policy, followed by every
+//! attempt the session executes before it asks the policy again (one
+//! attempt after an autonomous action; after a query, the expert's arm
+//! repeated until success or `n_att`), with the session's items, attempts,
+//! workload tracker and checks. A new `reset` abandons the running episode.
 
-use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Mutex, MutexGuard};
-use std::thread::JoinHandle;
 
 use hil_config::{BuildContext, TaskContext};
 use hil_config::{
     EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig, check_session_limits,
 };
 use hil_core::{
-    ArmId, Choice, Context, Decision, DecisionInput, Environment, EpisodeReport, Feedback,
-    HilError, Policy, QueryChannel, QueryHistory, QueryKind, Session, SessionObserver,
-    SessionSettings, StepEvent, Timestep, WorkloadForecast, WorkloadModel,
+    ArmId, Choice, Context, Decision, DecisionInput, Environment, Episode, EpisodeReport, Feedback,
+    HilError, Policy, QueryChannel, QueryKind, Session, SessionSettings, StepEvent, Timestep,
+    WorkloadModel,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
@@ -64,7 +59,8 @@ struct GymConfig {
     fallback_arm: usize,
 }
 
-/// What the agent sees when it must decide: the session's decision input.
+/// What the agent sees when it must decide, read from the session's
+/// decision input.
 #[derive(Clone, Debug)]
 struct Pending {
     context: Context,
@@ -73,32 +69,40 @@ struct Pending {
     item_label: String,
     items_seen: usize,
     attempt: u32,
-    wl0: f64,
-    history: QueryHistory,
+    n_queries: usize,
     wl_now: f64,
     wl_if_ask: f64,
 }
 
-/// Messages from the session's thread to the environment.
-enum FromSession {
-    ItemStart(String),
-    Decide(Box<Pending>),
-    Executed(Box<StepEvent>),
-    Finished(Box<hil_core::Result<EpisodeReport>>),
+impl Pending {
+    /// The decision `episode` awaits, if any; `kind` is what "ask" asks.
+    fn of(episode: &Episode, kind: QueryKind) -> hil_core::Result<Option<Self>> {
+        let Some(input) = episode.pending() else {
+            return Ok(None);
+        };
+        Ok(Some(Self {
+            context: input.context.clone(),
+            t: input.t,
+            item_index: input.item_index,
+            item_label: episode.item().map(|i| i.label.clone()).unwrap_or_default(),
+            items_seen: input.items_seen,
+            attempt: input.attempt,
+            n_queries: input.workload.history().len(),
+            wl_now: input.workload.now()?,
+            wl_if_ask: input.workload.if_queried(kind)?,
+        }))
+    }
 }
 
-/// The policy of the worker's session: it forwards each decision to the
-/// agent. It learns nothing itself (the agent learns from `info`).
-struct RemotePolicy {
+/// The policy of the engine's session: the agent decides outside the
+/// session (`step` feeds its action) and learns from `info`, so this
+/// policy only states the shape the session checks.
+struct Agent {
     n_arms: usize,
     dim: usize,
-    kind: QueryKind,
-    fallback: ArmId,
-    to_gym: Sender<FromSession>,
-    actions: Receiver<usize>,
 }
 
-impl Policy for RemotePolicy {
+impl Policy for Agent {
     fn name(&self) -> &str {
         "gymnasium_agent"
     }
@@ -108,78 +112,26 @@ impl Policy for RemotePolicy {
     fn dim(&self) -> usize {
         self.dim
     }
-    fn decide(&mut self, input: &DecisionInput<'_>) -> hil_core::Result<Decision> {
-        let pending = Pending {
-            context: input.context.clone(),
-            t: input.t,
-            item_index: input.item_index,
-            item_label: String::new(), // filled in by the environment
-            items_seen: input.items_seen,
-            attempt: input.attempt,
-            wl0: input.workload.wl0(),
-            history: input.workload.history().clone(),
-            wl_now: input.workload.now()?,
-            wl_if_ask: input.workload.if_queried(self.kind)?,
-        };
-        let abandoned = || HilError::state("gymnasium agent", "the episode was abandoned");
-        self.to_gym
-            .send(FromSession::Decide(Box::new(pending)))
-            .map_err(|_| abandoned())?;
-        let action = self.actions.recv().map_err(|_| abandoned())?;
-        Ok(if action == self.n_arms {
-            Decision::query(self.kind, self.fallback)
-        } else {
-            Decision::act(ArmId(action))
-        })
+    fn decide(&mut self, _: &DecisionInput<'_>) -> hil_core::Result<Decision> {
+        Err(HilError::state(
+            "gymnasium agent",
+            "it decides outside the session: its action is fed by step()",
+        ))
     }
     fn observe(&mut self, _: &Feedback<'_>) -> hil_core::Result<()> {
         Ok(())
     }
 }
 
-/// Forwards each item's start and every executed step. A closed channel
-/// means the episode was abandoned; the remote policy reports that at its
-/// next decision.
-struct Forwarder {
-    to_gym: Sender<FromSession>,
-}
-
-impl SessionObserver for Forwarder {
-    fn on_item_start(&mut self, item: &hil_core::Item) -> hil_core::Result<()> {
-        let _ = self.to_gym.send(FromSession::ItemStart(item.label.clone()));
-        Ok(())
-    }
-    fn on_step(&mut self, event: &StepEvent) -> hil_core::Result<()> {
-        let _ = self
-            .to_gym
-            .send(FromSession::Executed(Box::new(event.clone())));
-        Ok(())
-    }
-}
-
-/// The components a session borrows; they move to the worker for an
-/// episode and come back when it ends.
-struct Parts {
+/// The components, the episode in progress and what its last step did.
+struct Engine {
     environment: Box<dyn Environment>,
     channel: Box<dyn QueryChannel>,
-}
-
-/// An episode in progress on the worker thread.
-struct Running {
-    actions: Sender<usize>,
-    events: Receiver<FromSession>,
-    worker: JoinHandle<Parts>,
-}
-
-struct Engine {
-    parts: Option<Parts>,
-    running: Option<Running>,
-    /// The decision the agent owes, if any.
-    pending: Option<Pending>,
+    agent: Agent,
+    episode: Option<Episode>,
     /// The attempts executed by the last step.
     executed: Vec<StepEvent>,
-    /// The label of the item being attempted.
-    item_label: String,
+    /// The report, once the episode has ended.
     report: Option<EpisodeReport>,
 }
 
@@ -202,61 +154,57 @@ impl GymCore {
             .lock()
             .map_err(|_| to_py_err(HilError::state("gymnasium environment", "a step panicked")))
     }
-}
 
-impl Engine {
-    /// Ends the running episode, if any, and takes its components back.
-    fn stop(&mut self) -> hil_core::Result<()> {
-        if let Some(run) = self.running.take() {
-            drop(run.actions);
-            drop(run.events);
-            let parts = run.worker.join().map_err(|_| {
-                HilError::state("gymnasium environment", "the session's thread panicked")
-            })?;
-            self.parts = Some(parts);
-        }
-        Ok(())
-    }
-
-    /// Collects what the session does until it asks the agent again or the
-    /// episode ends.
-    fn advance(&mut self) -> hil_core::Result<()> {
-        self.executed.clear();
-        let Some(run) = &self.running else {
-            return Err(HilError::state(
-                "gymnasium environment",
-                "no episode is running: call reset()",
-            ));
-        };
-        loop {
-            let message = run.events.recv().map_err(|_| {
-                HilError::state("gymnasium environment", "the session's thread ended early")
-            })?;
-            match message {
-                FromSession::ItemStart(label) => self.item_label = label,
-                FromSession::Executed(e) => self.executed.push(*e),
-                FromSession::Decide(mut p) => {
-                    p.item_label.clone_from(&self.item_label);
-                    self.pending = Some(*p);
-                    return Ok(());
-                }
-                FromSession::Finished(result) => {
-                    self.pending = None;
-                    self.stop()?;
-                    self.report = Some((*result)?);
-                    return Ok(());
-                }
-            }
-        }
+    /// Runs `f` with the engine's session and its episode slot, the
+    /// executed attempts and the report.
+    fn with_session<T>(
+        &self,
+        engine: &mut Engine,
+        f: impl FnOnce(
+            &mut Session<'_>,
+            &mut Option<Episode>,
+            &mut Vec<StepEvent>,
+            &mut Option<EpisodeReport>,
+        ) -> hil_core::Result<T>,
+    ) -> hil_core::Result<T> {
+        let Engine {
+            environment,
+            channel,
+            agent,
+            episode,
+            executed,
+            report,
+        } = engine;
+        let mut session = Session::new(
+            self.settings.clone(),
+            environment.as_mut(),
+            agent,
+            channel.as_mut(),
+            self.workload.clone(),
+        );
+        f(&mut session, episode, executed, report)
     }
 }
 
-impl Drop for GymCore {
-    fn drop(&mut self) {
-        if let Ok(engine) = self.engine.get_mut() {
-            let _ = engine.stop();
-        }
-    }
+/// Moves `episode` on to its next decision, or finishes it when no item is
+/// left, returning its report then; the attempts executed from event
+/// `from` on are copied into `executed`.
+fn advance(
+    session: &mut Session<'_>,
+    episode: &mut Episode,
+    from: usize,
+    executed: &mut Vec<StepEvent>,
+) -> hil_core::Result<Option<EpisodeReport>> {
+    let more = session.next_decision(episode, &mut [])?.is_some();
+    let report = if more {
+        None
+    } else {
+        Some(session.finish_episode(episode, &mut [])?)
+    };
+    let events = report.as_ref().map_or(episode.events(), |r| &r.events);
+    executed.clear();
+    executed.extend_from_slice(events.get(from..).unwrap_or_default());
+    Ok(report)
 }
 
 fn context_array<'py>(py: Python<'py>, c: &Context) -> Bound<'py, PyArray1<f64>> {
@@ -311,8 +259,8 @@ impl GymCore {
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let mut guard = self.engine()?;
         let engine: &mut Engine = &mut guard;
-        py.detach(|| self.start(engine, seed)).map_err(to_py_err)?;
-        let Some(p) = &engine.pending else {
+        let pending = py.detach(|| self.start(engine, seed)).map_err(to_py_err)?;
+        let Some(p) = pending else {
             return Err(to_py_err(HilError::state(
                 "gymnasium environment",
                 format!(
@@ -322,7 +270,7 @@ impl GymCore {
             )));
         };
         let info = PyDict::new(py);
-        pending_info(&info, p)?;
+        pending_info(&info, &p)?;
         Ok((context_array(py, &p.context), info))
     }
 
@@ -347,25 +295,16 @@ impl GymCore {
                 "action {action} is outside 0..={n_arms} (arms 0..{n_arms}, {n_arms} = ask)"
             )));
         }
+        let decision = if action == n_arms {
+            Decision::query(self.kind, self.fallback)
+        } else {
+            Decision::act(ArmId(action))
+        };
         let mut guard = self.engine()?;
         let engine: &mut Engine = &mut guard;
-        let Some(before) = engine.pending.take() else {
-            return Err(to_py_err(HilError::state(
-                "gymnasium environment",
-                "the episode has ended: call reset()",
-            )));
-        };
-        let sent = engine
-            .running
-            .as_ref()
-            .is_some_and(|r| r.actions.send(action).is_ok());
-        if !sent {
-            return Err(to_py_err(HilError::state(
-                "gymnasium environment",
-                "the session's thread ended early",
-            )));
-        }
-        py.detach(|| engine.advance()).map_err(to_py_err)?;
+        let (before, after) = py
+            .detach(|| self.feed(engine, decision))
+            .map_err(to_py_err)?;
         let engine: &Engine = engine;
 
         let info = PyDict::new(py);
@@ -403,7 +342,7 @@ impl GymCore {
         info.set_item("executed_from_expert", from_expert(executed))?;
         info.set_item("executed_contexts", contexts.into_pyarray(py))?;
         info.set_item("wl_t", wl_after)?;
-        let (obs, terminated) = match &engine.pending {
+        let (obs, terminated) = match &after {
             Some(p) => {
                 pending_info(&info, p)?;
                 (context_array(py, &p.context), false)
@@ -443,7 +382,7 @@ impl GymCore {
         let policy = policy.get();
         self.check_policy(policy)?;
         let engine = self.engine()?;
-        let Some(p) = &engine.pending else {
+        let Some(episode) = engine.episode.as_ref().filter(|e| e.pending().is_some()) else {
             return Err(to_py_err(HilError::state(
                 "gymnasium environment",
                 "no decision is pending: call reset()",
@@ -451,13 +390,9 @@ impl GymCore {
         };
         let n_arms = self.n_arms();
         py.detach(|| {
-            let forecast =
-                WorkloadForecast::new(Some(self.workload.as_ref()), p.wl0, &p.history, p.t);
-            let input = DecisionInput::new(&p.context, p.t, forecast).at_item(
-                p.item_index,
-                p.items_seen,
-                p.attempt,
-            );
+            let input = episode.pending().ok_or_else(|| {
+                HilError::state("gymnasium environment", "no decision is pending")
+            })?;
             Ok(match policy.state().decide(&input)?.choice {
                 Choice::Act { arm } => arm.0,
                 Choice::Query { .. } => n_arms,
@@ -526,74 +461,59 @@ impl GymCore {
             kind: config.query_kind,
             fallback: ArmId(config.fallback_arm),
             environment_name: environment.name().to_string(),
-            task,
             engine: Mutex::new(Engine {
-                parts: Some(Parts {
-                    environment,
-                    channel,
-                }),
-                running: None,
-                pending: None,
+                environment,
+                channel,
+                agent: Agent {
+                    n_arms: task.action_space().len(),
+                    dim: task.context_dim(),
+                },
+                episode: None,
                 executed: Vec::new(),
-                item_label: String::new(),
                 report: None,
             }),
+            task,
         })
     }
 
-    /// Starts the worker's session for the episode seeded by `seed` and
-    /// waits for its first decision.
-    fn start(&self, engine: &mut Engine, seed: u64) -> hil_core::Result<()> {
-        engine.stop()?;
-        engine.pending = None;
-        engine.report = None;
-        let mut parts = engine.parts.take().ok_or_else(|| {
-            HilError::state(
-                "gymnasium environment",
-                "its components were lost by a failed episode",
-            )
-        })?;
-        let (to_gym, events) = channel();
-        let (actions_tx, actions) = channel();
-        let mut remote = RemotePolicy {
-            n_arms: self.task.action_space().len(),
-            dim: self.task.context_dim(),
-            kind: self.kind,
-            fallback: self.fallback,
-            to_gym: to_gym.clone(),
-            actions,
-        };
-        let mut forwarder = Forwarder {
-            to_gym: to_gym.clone(),
-        };
-        let settings = self.settings.clone();
-        let workload = self.workload.clone();
-        let worker = std::thread::Builder::new()
-            .name("hil-gym-session".into())
-            .spawn(move || {
-                let result = Session::new(
-                    settings,
-                    parts.environment.as_mut(),
-                    &mut remote,
-                    parts.channel.as_mut(),
-                    workload,
-                )
-                .run_episode(seed, &mut [&mut forwarder]);
-                let _ = to_gym.send(FromSession::Finished(Box::new(result)));
-                parts
-            })
-            .map_err(|e| {
+    /// Starts the episode seeded by `seed` (dropping any running one) and
+    /// moves it to its first decision, which it returns (`None` if the
+    /// episode ended first).
+    fn start(&self, engine: &mut Engine, seed: u64) -> hil_core::Result<Option<Pending>> {
+        self.with_session(engine, |session, slot, executed, report| {
+            *slot = None;
+            *report = None;
+            let mut episode = session.start_episode(seed, &mut [])?;
+            *report = advance(session, &mut episode, 0, executed)?;
+            executed.clear();
+            let pending = Pending::of(&episode, self.kind)?;
+            *slot = Some(episode);
+            Ok(pending)
+        })
+    }
+
+    /// Feeds `decision` to the decision awaited and moves on to the next
+    /// one. Returns the decision answered and the next one (`None` when
+    /// the episode has ended).
+    fn feed(
+        &self,
+        engine: &mut Engine,
+        decision: Decision,
+    ) -> hil_core::Result<(Pending, Option<Pending>)> {
+        self.with_session(engine, |session, slot, executed, report| {
+            let ended = || {
                 HilError::state(
                     "gymnasium environment",
-                    format!("cannot start its thread: {e}"),
+                    "the episode has ended: call reset()",
                 )
-            })?;
-        engine.running = Some(Running {
-            actions: actions_tx,
-            events,
-            worker,
-        });
-        engine.advance()
+            };
+            let episode = slot.as_mut().ok_or_else(ended)?;
+            let before = Pending::of(episode, self.kind)?.ok_or_else(ended)?;
+            let from = episode.events().len();
+            session.feed_decision(episode, decision, &mut [])?;
+            *report = advance(session, episode, from, executed)?;
+            Ok((before, Pending::of(episode, self.kind)?))
+        })
     }
 }
 
@@ -625,7 +545,7 @@ fn pending_info(info: &Bound<'_, PyDict>, p: &Pending) -> PyResult<()> {
     info.set_item("attempt", p.attempt)?;
     info.set_item("workload", p.wl_now)?;
     info.set_item("workload_if_ask", p.wl_if_ask)?;
-    info.set_item("n_queries", p.history.len())?;
+    info.set_item("n_queries", p.n_queries)?;
     Ok(())
 }
 

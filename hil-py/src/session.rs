@@ -5,12 +5,11 @@
 //! Ctrl-C stops it between two steps ([`crate::interrupt`]), the log then
 //! holding every step so far.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use hil_core::record::{Header, RecordLog};
+use hil_core::record::Header;
 use hil_core::{EventCollector, HilError, SessionObserver, SessionSettings};
-use hil_experiments::ExperimentConfig;
-use hil_experiments::run_recorded;
+use hil_experiments::run::{Recording, Run, run_with};
 use hil_experiments::{Experiment, ExperimentSummary};
 use pyo3::prelude::*;
 
@@ -23,28 +22,6 @@ use crate::interrupt::StopAtBoundary;
 /// components were given in code, so a resume gives them again.
 const CODE_SESSION: &str =
     "# a session whose components were given in Python code (hil.run_session)\n";
-
-/// Where a session's steps are recorded.
-enum Recording {
-    /// Nowhere.
-    Off,
-    /// In a new interaction log with this header.
-    To(PathBuf, Header),
-    /// Appended to this log, continuing the session it records.
-    Resume(PathBuf),
-}
-
-impl Recording {
-    /// Records to `log` (if given) under a header made by `header`, or
-    /// continues the session in `resume` (if given).
-    fn of(log: Option<PathBuf>, resume: Option<PathBuf>, header: impl FnOnce() -> Header) -> Self {
-        match (log, resume) {
-            (_, Some(path)) => Self::Resume(path),
-            (Some(path), None) => Self::To(path, header()),
-            (None, None) => Self::Off,
-        }
-    }
-}
 
 /// Runs `exp` as `recording` says on a worker thread, with the GIL
 /// released; Ctrl-C (or any exception a signal handler raises) stops it at
@@ -64,14 +41,7 @@ fn drive(
             observers.push(&mut collector);
         }
         observers.push(&mut stopper);
-        let summary = match recording {
-            Recording::Resume(path) => RecordLog::open(&path).and_then(|(log, logged)| {
-                run_recorded(&mut exp, log, Some(&logged), &mut observers, |_, _| {})
-            }),
-            Recording::To(path, header) => RecordLog::create(&path, header)
-                .and_then(|log| run_recorded(&mut exp, log, None, &mut observers, |_, _| {})),
-            Recording::Off => exp.run(&mut observers, |_, _| {}),
-        };
+        let summary = run_with(&mut exp, recording, &mut observers, |_, _| {});
         drop(observers);
         (summary, collector)
     })?;
@@ -98,22 +68,10 @@ pub(crate) fn run(
     log: Option<PathBuf>,
     events: bool,
 ) -> PyResult<Py<PyAny>> {
-    let text = hil_core::files::read_text(&config, hil_core::files::limits::CONFIG).py_err()?;
-    let cfg = ExperimentConfig::parse(&text, &config)
-        .map_err(HilError::from)
+    let run = py
+        .detach(|| Run::from_config(&config, log.as_deref()))
         .py_err()?;
-    let config_abs = std::path::absolute(&config)
-        .map_err(|e| HilError::io("resolving", &config, e))
-        .py_err()?;
-    let base = config_abs
-        .parent()
-        .map_or_else(|| config_abs.clone(), Path::to_path_buf);
-    let exp = py.detach(|| cfg.build(&base)).py_err()?;
-    let (seed, episodes) = (exp.seed, exp.episodes);
-    let recording = Recording::of(log, None, || {
-        Header::new(&text, config_abs, base, seed, episodes)
-    });
-    drive(py, exp, recording, events)
+    drive(py, run.experiment, run.recording, events)
 }
 
 /// Continues the session recorded in `log` by `run(config, log=...)` (after
@@ -123,11 +81,11 @@ pub(crate) fn run(
 #[pyfunction]
 #[pyo3(signature = (log, *, events=false))]
 pub(crate) fn resume(py: Python<'_>, log: PathBuf, events: bool) -> PyResult<Py<PyAny>> {
-    let header = {
-        let (_, logged) = RecordLog::open(&log).py_err()?;
-        logged.header
-    };
-    if header.config == CODE_SESSION {
+    let recording = Recording::open(&log).py_err()?;
+    if recording
+        .logged()
+        .is_some_and(|l| l.header.config == CODE_SESSION)
+    {
         return Err(crate::errors::to_py_err(HilError::invalid_input(
             "log",
             format!(
@@ -136,11 +94,8 @@ pub(crate) fn resume(py: Python<'_>, log: PathBuf, events: bool) -> PyResult<Py<
             ),
         )));
     }
-    let cfg = ExperimentConfig::parse(&header.config, &header.config_path)
-        .map_err(HilError::from)
-        .py_err()?;
-    let exp = py.detach(|| cfg.build(&header.base_dir)).py_err()?;
-    drive(py, exp, Recording::Resume(log), events)
+    let run = py.detach(|| Run::resume_from(recording)).py_err()?;
+    drive(py, run.experiment, run.recording, events)
 }
 
 /// Runs `episodes` episodes of hil's session loop over components given in
@@ -186,9 +141,15 @@ pub(crate) fn run_session(
         workload: workload_arg(workload)?,
         forecast: forecast.map(workload_arg).transpose()?,
     };
-    let recording = Recording::of(log, resume, || {
-        Header::new(CODE_SESSION, "<python>", ".", seed, episodes)
-    });
+    let recording = match (log, resume) {
+        (_, Some(path)) => Recording::open(&path),
+        (Some(path), None) => Recording::create(
+            &path,
+            Header::new(CODE_SESSION, "<python>", ".", seed, episodes),
+        ),
+        (None, None) => Ok(Recording::Off),
+    }
+    .py_err()?;
     drive(py, exp, recording, events)
 }
 

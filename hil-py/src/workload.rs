@@ -7,9 +7,9 @@ use std::sync::Arc;
 
 use hil_core::HilError;
 use hil_workload::bundle::{StudySummary, bundled_study};
-use hil_workload::datasets::{Dataset, DatasetId};
+use hil_workload::datasets::DatasetId;
 use hil_workload::models::FittedModel;
-use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_study_model};
+use hil_workload::select::{Candidate, SelectOptions, fit_study_model, select_study_models};
 use hil_workload::study::Study;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
@@ -101,16 +101,7 @@ pub(crate) fn select_workload(
     if let Some(h) = histories {
         opts.histories = h;
     }
-    let table = py
-        .detach(|| {
-            let sets: Vec<Dataset> = DatasetId::ALL
-                .iter()
-                .map(|&id| Dataset::build(&study, id))
-                .collect::<hil_core::Result<_>>()?;
-            let refs: Vec<&Dataset> = sets.iter().collect();
-            cross_validate(&refs, &Candidate::table(&opts.histories), &opts)
-        })
-        .py_err()?;
+    let table = py.detach(|| select_study_models(&study, &opts)).py_err()?;
     to_py(py, &table, "selection table")
 }
 

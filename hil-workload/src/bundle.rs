@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::datasets::{Dataset, DatasetId};
 use crate::models::{FittedModel, Provenance};
-use crate::select::{Candidate, SelectOptions, SelectionTable, cross_validate, fit_on_all};
+use crate::select::{SelectOptions, SelectionTable, fit_on_all, select_among, study_datasets};
 use crate::study::Study;
 use crate::synth::SynthConfig;
 
@@ -92,12 +92,8 @@ pub fn build_bundle(
     data_label: &str,
     opts: &SelectOptions,
 ) -> Result<(SelectionTable, Vec<FittedModel>)> {
-    let sets: Vec<Dataset> = DatasetId::ALL
-        .iter()
-        .map(|&id| Dataset::build(study, id))
-        .collect::<Result<_>>()?;
-    let refs: Vec<&Dataset> = sets.iter().collect();
-    let table = cross_validate(&refs, &Candidate::table(&opts.histories), opts)?;
+    let sets = study_datasets(study)?;
+    let table = select_among(&sets, opts)?;
     let note = "fitted on synthetic study data calibrated to the paper's published figures; not real participant data";
     // Every bundled model records its data set, size, CV error and how it
     // was chosen, followed by the synthetic-data note.

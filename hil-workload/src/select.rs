@@ -579,6 +579,43 @@ pub fn fit_study_model(
     ))
 }
 
+/// Cross-validated model selection on a study: every candidate of the
+/// paper's table (with `opts.histories`) scored by nested CV on each of its
+/// datasets D1, D2 and D12 ([`cross_validate`]). What `hil workload select`
+/// and hil-py's `select_workload` run, and what the bundled models are
+/// chosen by.
+///
+/// ```
+/// use hil_workload::{datasets::DatasetId, select::*, synth::SynthConfig};
+/// let study = SynthConfig::small(8, 4).generate(1).unwrap();
+/// let opts = SelectOptions { histories: vec![1], ..SelectOptions::default() };
+/// let table = select_study_models(&study, &opts).unwrap();
+/// for id in DatasetId::ALL {
+///     assert!(table.best(id).is_some());
+/// }
+/// ```
+pub fn select_study_models(
+    study: &crate::study::Study,
+    opts: &SelectOptions,
+) -> Result<SelectionTable> {
+    select_among(&study_datasets(study)?, opts)
+}
+
+/// Every candidate of the paper's table (with `opts.histories`) scored on
+/// each of `sets` ([`cross_validate`]).
+pub(crate) fn select_among(sets: &[Dataset], opts: &SelectOptions) -> Result<SelectionTable> {
+    let refs: Vec<&Dataset> = sets.iter().collect();
+    cross_validate(&refs, &Candidate::table(&opts.histories), opts)
+}
+
+/// The datasets D1, D2 and D12 of `study`, in [`DatasetId::ALL`] order.
+pub fn study_datasets(study: &crate::study::Study) -> Result<Vec<Dataset>> {
+    DatasetId::ALL
+        .iter()
+        .map(|&id| Dataset::build(study, id))
+        .collect()
+}
+
 fn fmt_num(x: f64) -> String {
     if x.is_finite() && (1e-3..1e3).contains(&x.abs()) {
         format!("{x:.4}")

@@ -1,13 +1,11 @@
 //! `hil run --config FILE [--log LOG]`: run an experiment config, recording
 //! every step; `hil run --resume LOG`: continue a recorded session.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use hil_core::record::{Header, RecordLog};
-use hil_core::{EpisodeMetrics, HilError, SessionObserver, StepEvent};
+use hil_core::{EpisodeMetrics, HilError, SessionObserver};
 use hil_experiments::ExperimentSummary;
-use hil_experiments::run_recorded;
+use hil_experiments::run::{JsonlEvents, Recording, Run};
 
 /// Arguments of `hil run`.
 #[derive(Debug, clap::Args)]
@@ -36,24 +34,6 @@ pub struct RunArgs {
     /// Print nothing but errors (and the JSON summary with --json).
     #[arg(long, short)]
     pub quiet: bool,
-}
-
-/// Writes step events as JSON lines.
-struct JsonlEvents {
-    path: PathBuf,
-    out: std::io::BufWriter<std::fs::File>,
-}
-
-impl SessionObserver for JsonlEvents {
-    fn on_step(&mut self, event: &StepEvent) -> hil_core::Result<()> {
-        // Serialised apart from writing, so that a failing file (a full
-        // disk, /dev/full) is reported as an I/O error naming it.
-        let mut line = serde_json::to_vec(event).map_err(|e| HilError::serde("step event", e))?;
-        line.push(b'\n');
-        self.out
-            .write_all(&line)
-            .map_err(|e| HilError::io("writing", &self.path, e))
-    }
 }
 
 /// The session to run: a fresh one from a config, or a logged one to resume.
@@ -101,15 +81,11 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
         }
     };
     let quiet = args.quiet || args.json;
-    let mut sink = match &args.events {
-        Some(p) => Some(JsonlEvents {
-            path: p.clone(),
-            out: std::io::BufWriter::new(
-                std::fs::File::create(p).map_err(|e| HilError::io("creating", p, e))?,
-            ),
-        }),
-        None => None,
-    };
+    let mut sink = args
+        .events
+        .as_deref()
+        .map(JsonlEvents::create)
+        .transpose()?;
     let mut observers: Vec<&mut dyn SessionObserver> = Vec::new();
     if let Some(s) = sink.as_mut() {
         observers.push(s);
@@ -127,60 +103,33 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
         Start::Fresh { log, .. } => log.clone(),
         Start::Resume(log) => Some(log.clone()),
     });
-    let summary = match start {
-        Start::Fresh { config, log } => {
-            let text = hil_core::files::read_text(&config, hil_core::files::limits::CONFIG)?;
-            let cfg = hil_experiments::parse_experiment(&text, &config)?;
-            // Absolute, so that a resume from another directory finds the
-            // same files; made absolute before taking the directory, which
-            // for a bare file name (`exp.toml`) is empty.
-            let config_abs = absolute(&config)?;
-            let base = config_abs
-                .parent()
-                .map_or_else(|| config_abs.clone(), Path::to_path_buf);
-            let mut exp = cfg.build(&base)?;
-            announce_endpoint(exp.channel.endpoint());
-            match log {
-                Some(log_path) => {
-                    let header = Header::new(&text, config_abs, base, exp.seed, exp.episodes);
-                    let log = RecordLog::create(&log_path, header)?;
-                    if !quiet {
-                        eprintln!("recording to {}", log_path.display());
-                    }
-                    run_recorded(&mut exp, log, None, &mut observers, progress)?
-                }
-                None => exp.run(&mut observers, |k, r| progress(k, &r.metrics))?,
-            }
-        }
-        Start::Resume(log_path) => {
-            let (log, logged) = RecordLog::open(&log_path)?;
-            let header = &logged.header;
-            let cfg = hil_experiments::parse_experiment(&header.config, &header.config_path)?;
-            let mut exp = cfg.build(&header.base_dir)?;
-            if !quiet {
-                eprintln!(
-                    "resuming {} ({} records{})",
-                    log_path.display(),
-                    logged.records.len() + 1,
-                    if logged.truncated_bytes > 0 {
-                        format!(
-                            "; discarded an incomplete last line of {} bytes",
-                            logged.truncated_bytes
-                        )
-                    } else {
-                        String::new()
-                    }
-                );
-            }
-            announce_endpoint(exp.channel.endpoint());
-            run_recorded(&mut exp, log, Some(&logged), &mut observers, progress)?
-        }
+    let run = match &start {
+        Start::Fresh { config, log } => Run::from_config(config, log.as_deref())?,
+        Start::Resume(log) => Run::resume(log)?,
     };
+    if !quiet && let Some(logged) = run.recording.logged() {
+        eprintln!(
+            "resuming {} ({} records{})",
+            run.recording.path().unwrap_or(Path::new("")).display(),
+            logged.records.len() + 1,
+            if logged.truncated_bytes > 0 {
+                format!(
+                    "; discarded an incomplete last line of {} bytes",
+                    logged.truncated_bytes
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
+    announce_endpoint(run.experiment.channel.endpoint());
+    if !quiet && let Recording::New(log) = &run.recording {
+        eprintln!("recording to {}", log.path().display());
+    }
+    let summary = run.execute(&mut observers, progress)?;
     drop(observers);
-    if let Some(mut s) = sink {
-        s.out
-            .flush()
-            .map_err(|e| HilError::io("writing", &s.path, e))?;
+    if let Some(s) = sink {
+        s.finish()?;
     }
     Ok(summary)
 }
@@ -226,10 +175,6 @@ fn announce_endpoint(endpoint: Option<String>) {
             eprintln!("  {url}");
         }
     }
-}
-
-fn absolute(path: &Path) -> hil_core::Result<PathBuf> {
-    std::path::absolute(path).map_err(|e| HilError::io("resolving", path, e))
 }
 
 fn print_summary(summary: &ExperimentSummary, json: bool, quiet: bool) -> hil_core::Result<()> {

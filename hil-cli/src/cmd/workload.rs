@@ -7,9 +7,9 @@ use std::time::Instant;
 use hil_core::WorkloadInput;
 use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadModel};
 use hil_workload::bundle::{StudySummary, build_bundle, bundled_study};
-use hil_workload::datasets::{Dataset, DatasetId};
+use hil_workload::datasets::DatasetId;
 use hil_workload::models::FittedModel;
-use hil_workload::select::{Candidate, SelectOptions, cross_validate, fit_study_model};
+use hil_workload::select::{Candidate, SelectOptions, fit_study_model, select_study_models};
 use hil_workload::study::Study;
 use hil_workload::synth::SynthConfig;
 
@@ -207,13 +207,8 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
         } => {
             let study = Study::load(&data)?;
             let t0 = Instant::now();
-            let sets: Vec<Dataset> = DatasetId::ALL
-                .iter()
-                .map(|&id| Dataset::build(&study, id))
-                .collect::<Result<_>>()?;
-            let refs: Vec<&Dataset> = sets.iter().collect();
             let opts = cv.options();
-            let table = cross_validate(&refs, &Candidate::table(&opts.histories), &opts)?;
+            let table = select_study_models(&study, &opts)?;
             let elapsed = t0.elapsed();
             write(&out.join("selection.md"), &table.to_markdown())?;
             write(&out.join("selection.csv"), &table.to_csv())?;

@@ -14,9 +14,13 @@
 //!   diagnostics must be finite, every workload prediction in [0, 1], a
 //!   response time finite and not negative, a success probability in
 //!   [0, 1]. The error names the component and the field.
+//! - An outside loop may drive an episode one decision at a time
+//!   ([`step`]: `next_decision` asks, `feed_decision` tells);
+//!   [`Session::run_episode`] is a loop over [`Session::step`].
 
 mod checks;
 pub mod observer;
+pub mod step;
 
 use std::sync::Arc;
 
@@ -24,16 +28,15 @@ use serde::{Deserialize, Serialize};
 
 use crate::action::ArmId;
 use crate::channel::QueryChannel;
-use crate::decision::Choice;
 use crate::environment::Environment;
 use crate::error::{HilError, Result};
 use crate::metrics::EpisodeMetrics;
-use crate::policy::{DecisionInput, Feedback, Policy};
-use crate::query::Query;
-use crate::workload::{DEFAULT_WL0, WorkloadForecast, WorkloadModel, WorkloadTracker, check_wl0};
+use crate::policy::Policy;
+use crate::workload::{DEFAULT_WL0, WorkloadModel, check_wl0};
 
 pub use crate::event::{self, PendingStep, StepDecision, StepEvent};
 pub use observer::{EventCollector, SessionObserver};
+pub use step::Episode;
 
 /// The paper's attempt limit per item in simulation.
 pub const DEFAULT_N_ATT: u32 = 10;
@@ -245,162 +248,17 @@ impl Session<'_> {
     }
 
     /// Runs one episode with explicit per-component seeds; `seed` labels
-    /// the episode in its report and for observers.
+    /// the episode in its report and for observers. It starts the episode,
+    /// takes [`Session::step`] until no item is left and finishes it.
     pub fn run_episode_with_seeds(
         &mut self,
         seed: u64,
         seeds: ComponentSeeds,
         observers: &mut [&mut dyn SessionObserver],
     ) -> Result<EpisodeReport> {
-        self.settings.validate()?;
-        self.check_shapes()?;
-        self.environment.reset(seeds.environment)?;
-        self.policy.seed(seeds.policy);
-        self.channel.seed(seeds.channel);
-        for o in observers.iter_mut() {
-            o.on_episode_start(seed)?;
-        }
-
-        // Every prediction, for the trace, the policy and the score, is
-        // checked to be a workload score.
-        let workload: Arc<dyn WorkloadModel> =
-            Arc::new(checks::CheckedWorkload(self.workload.clone()));
-        let mut tracker = WorkloadTracker::new(workload.clone(), self.settings.wl0)?;
-        let forecast_model: Arc<dyn WorkloadModel> = match &self.forecast {
-            Some(f) => Arc::new(checks::CheckedWorkload(f.clone())),
-            None => workload.clone(),
-        };
-        let mut events = Vec::new();
-        let mut t = 0;
-        let mut items_seen = 0;
-        while self.settings.max_items.is_none_or(|m| items_seen < m) {
-            let Some(item) = self.environment.next_item()? else {
-                break;
-            };
-            for o in observers.iter_mut() {
-                o.on_item_start(&item)?;
-            }
-            let mut expert: Option<ArmId> = None;
-            for attempt in 0..self.settings.n_att {
-                t += 1;
-                let context = self.environment.observe()?;
-                context.check_dim(self.environment.context_dim())?;
-                let (decision, diagnostics, response, arm) = match expert {
-                    Some(arm) => (StepDecision::FollowExpert { arm }, None, None, arm),
-                    None => {
-                        let input = DecisionInput {
-                            context: &context,
-                            t,
-                            item_index: item.index,
-                            items_seen,
-                            attempt,
-                            workload: WorkloadForecast::new(
-                                Some(forecast_model.as_ref()),
-                                tracker.wl0(),
-                                tracker.history(),
-                                t,
-                            ),
-                        };
-                        let decision = self.policy.decide(&input)?;
-                        checks::diagnostics(self.policy.name(), &decision.diagnostics)?;
-                        match decision.choice {
-                            Choice::Act { arm } => {
-                                self.check_arm(arm, "policy decision")?;
-                                (
-                                    StepDecision::Act { arm },
-                                    Some(decision.diagnostics),
-                                    None,
-                                    arm,
-                                )
-                            }
-                            Choice::Query { kind, fallback } => {
-                                self.check_arm(fallback, "policy fallback")?;
-                                let query = Query {
-                                    t,
-                                    item: item.clone(),
-                                    kind,
-                                    actions: self.environment.action_space().clone(),
-                                    context: context.clone(),
-                                    oracle_best: self.environment.best_action(),
-                                };
-                                let response = self.channel.ask(&query)?;
-                                checks::response(self.channel.name(), &response)?;
-                                // The person was interrupted whatever they answered.
-                                tracker.record(t, kind)?;
-                                let arm = match response.expert_arm {
-                                    Some(a) => {
-                                        self.check_arm(a, "expert answer")?;
-                                        expert = Some(a);
-                                        a
-                                    }
-                                    None => fallback,
-                                };
-                                (
-                                    StepDecision::Query { kind, fallback },
-                                    Some(decision.diagnostics),
-                                    Some(response),
-                                    arm,
-                                )
-                            }
-                        }
-                    }
-                };
-                let wl_t = tracker.advance(t)?;
-                let pending = PendingStep {
-                    t,
-                    item_index: item.index,
-                    item_label: item.label.clone(),
-                    attempt,
-                    context,
-                    decision,
-                    diagnostics,
-                    response,
-                    arm,
-                    wl_t,
-                };
-                for o in observers.iter_mut() {
-                    o.before_execute(&pending)?;
-                }
-                let outcome = self.environment.execute(arm)?;
-                if let Some(p) = outcome.success_probability
-                    && !(0.0..=1.0).contains(&p)
-                {
-                    return Err(HilError::invalid_input(
-                        format!("success probability from `{}`", self.environment.name()),
-                        format!("{p} is outside [0, 1]"),
-                    ));
-                }
-                self.policy.observe(&Feedback {
-                    context: &pending.context,
-                    arm,
-                    reward: outcome.reward(),
-                    t,
-                    from_expert: expert.is_some(),
-                })?;
-                let event = StepEvent {
-                    step: pending,
-                    outcome,
-                };
-                for o in observers.iter_mut() {
-                    o.on_step(&event)?;
-                }
-                let success = event.outcome.success;
-                events.push(event);
-                if success {
-                    break;
-                }
-            }
-            items_seen += 1;
-        }
-        let metrics = EpisodeMetrics::from_events(&events, self.settings.wl0, workload.as_ref())?;
-        for o in observers.iter_mut() {
-            o.on_episode_end(&metrics)?;
-        }
-        Ok(EpisodeReport {
-            seed,
-            events,
-            metrics,
-        })
+        let mut episode = self.start_episode_with_seeds(seed, seeds, observers)?;
+        while self.step(&mut episode, observers)? {}
+        self.finish_episode(&mut episode, observers)
     }
 
     fn check_arm(&self, arm: ArmId, what: &str) -> Result<()> {

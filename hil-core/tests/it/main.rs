@@ -4,3 +4,4 @@
 mod checkpoint_unsupported;
 mod properties;
 mod session_loop;
+mod session_step;

@@ -5,6 +5,7 @@ mod experiment_config;
 mod protocol_components;
 mod record;
 mod record_fuzz;
+mod run_flow;
 mod session_checks;
 mod testbed;
 #[cfg(feature = "physics")]

@@ -66,6 +66,17 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String> {
     })
 }
 
+/// Writes `text` to `path`, creating its folder first if needed: the one
+/// writer of the text outputs commands produce (tables, CSV, SVG).
+///
+/// Errors are [`HilError::Io`] naming the folder or the file.
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| HilError::io("creating", dir, e))?;
+    }
+    std::fs::write(path, text).map_err(|e| HilError::io("writing", path, e))
+}
+
 /// Reads a whole regular file of at most `limit` bytes.
 ///
 /// The file is checked (regular, size) before any byte is read, and the

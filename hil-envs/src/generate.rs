@@ -127,6 +127,17 @@ impl Generated {
     }
 }
 
+/// A dataset [`SyntheticFoods::write_into`] wrote.
+#[derive(Clone, Debug)]
+pub struct Written {
+    /// What was generated.
+    pub generated: Generated,
+    /// The manifest (`dataset.toml`).
+    pub manifest: std::path::PathBuf,
+    /// The generator's parameters (`generator.toml`), to regenerate it.
+    pub parameters: std::path::PathBuf,
+}
+
 impl SyntheticFoods {
     /// A small generator for tests and examples: the default foods and
     /// rates at 224 features and 3 images per setting.
@@ -141,6 +152,29 @@ impl SyntheticFoods {
             images_per_setting: 3,
             ..Self::default()
         }
+    }
+
+    /// Generates the dataset and writes it into `dir` ([`Generated::save`])
+    /// with these parameters as `generator.toml` beside it. A `dir` that
+    /// exists and is not empty is refused unless `overwrite`.
+    pub fn write_into(&self, dir: &std::path::Path, overwrite: bool) -> Result<Written> {
+        let non_empty = std::fs::read_dir(dir).is_ok_and(|mut d| d.next().is_some());
+        if non_empty && !overwrite {
+            return Err(HilError::invalid_input(
+                format!("output directory {}", dir.display()),
+                "it is not empty; pass --force to overwrite",
+            ));
+        }
+        let generated = self.generate()?;
+        let manifest = generated.save(dir)?;
+        let params = toml::to_string_pretty(self).map_err(|e| HilError::serde("generator", e))?;
+        let parameters = dir.join("generator.toml");
+        std::fs::write(&parameters, params).map_err(|e| HilError::io("writing", &parameters, e))?;
+        Ok(Written {
+            generated,
+            manifest,
+            parameters,
+        })
     }
 
     /// Checks the parameters.

@@ -56,6 +56,7 @@ use hil_workload::models::{FittedModel, GrangerModel, GrangerVariant, ModelSpec,
 
 use crate::testbed::ProtocolSettings;
 use hil_core::WorkloadInput;
+use std::path::{Path, PathBuf};
 
 /// The simulation models, in the paper's table order.
 pub const SIM_MODELS: [&str; 3] = ["f1_sim", "f2_sim", "f12_sim"];
@@ -419,6 +420,26 @@ pub fn all() -> Result<Vec<FittedModel>> {
         }
     }
     Ok(out)
+}
+
+/// Where a calibrated model's file lives in the hil-workload crate folder
+/// `dir`: `models/<name>.json`.
+pub fn model_path(dir: &Path, model: &FittedModel) -> PathBuf {
+    dir.join(format!("models/{}.json", model.name))
+}
+
+/// The files under `dir` ([`model_path`]) that differ from `models`: what
+/// `hil workload calibrate --check` refuses. A missing file is an error.
+pub fn stale_files(dir: &Path, models: &[FittedModel]) -> Result<Vec<PathBuf>> {
+    let mut stale = Vec::new();
+    for m in models {
+        let path = model_path(dir, m);
+        let on_disk = hil_core::files::read_text(&path, hil_core::files::limits::MODEL)?;
+        if on_disk != m.to_json() {
+            stale.push(path);
+        }
+    }
+    Ok(stale)
 }
 
 /// A Markdown table of calibrated `models` (as [`all`] returns them) on

@@ -20,10 +20,11 @@
 //!   cross-data experiment);
 //! - [`components`]: the testbed's pluggable parts (the query channel and
 //!   environment of every episode; the paper's by default);
-//! - `user_study`: the paper's real-robot user-study protocol (methods
-//!   in counterbalanced order, per-plate results, mean ± standard error),
-//!   in the MuJoCo scene, so only with the crate feature `physics` (run
-//!   `scripts/setup-mujoco` first);
+//! - [`user_study`]: the paper's real-robot user-study protocol (methods
+//!   in counterbalanced order, per-plate results, mean ± standard error)
+//!   on any environment, and over many seeds; its default scene is the
+//!   MuJoCo simulation, which needs the crate feature `physics` (run
+//!   `scripts/setup-mujoco` first), as do its keyframes;
 //! - [`run`]: running an experiment file with its interaction record, and
 //!   resuming one from its log (what `hil run` and hil-py's `hil.run` do);
 //! - [`results`]: selection and aggregation; [`report`]: Markdown tables
@@ -49,7 +50,6 @@ pub mod report;
 pub mod results;
 pub mod run;
 pub mod testbed;
-#[cfg(feature = "physics")]
 pub mod user_study;
 
 pub use builtin::{load_experiment, parse_experiment};
@@ -58,5 +58,4 @@ pub use experiment_config::{ExperimentConfig, load_plugins};
 pub use method::Method;
 pub use recorded::run_recorded;
 pub use testbed::{NamedModel, Protocol, ProtocolSettings};
-#[cfg(feature = "physics")]
 pub use user_study::{UserStudy, UserStudyConfig, UserStudyResult};

@@ -48,9 +48,9 @@ use hil_core::{
 };
 use hil_envs::env::{PretrainReward, pretraining_data};
 use hil_envs::{FoodDataset, FoodSplit};
+use hil_jobs::Runner;
 use hil_paper::methods::{ALWAYS_QUERY, LINUCB_EXPDECAY, LINUCB_QG, PaperMethod};
 use hil_paper::simulation;
-use rayon::prelude::*;
 
 use crate::calibrate::End;
 use crate::components::{
@@ -661,6 +661,9 @@ pub struct Protocol {
     /// Builds the environment of every episode (the paper's: dataset
     /// replay over the phase's foods).
     pub environment: SharedEnvironmentFactory,
+    /// Runs the episodes in parallel (default: rayon's pool,
+    /// `RAYON_NUM_THREADS` or one worker per core).
+    pub runner: Runner,
 }
 
 impl std::fmt::Debug for Protocol {
@@ -671,8 +674,17 @@ impl std::fmt::Debug for Protocol {
             .field("models", &self.models)
             .field("channel", &self.channel.name())
             .field("environment", &self.environment.name())
+            .field("threads", &self.runner.threads())
             .finish()
     }
+}
+
+/// Why a job of [`Protocol::run_until_cancelled`] stopped the run.
+enum Stop {
+    /// The cancel flag was raised before the job started.
+    Cancelled,
+    /// The job's run failed.
+    Failed(HilError),
 }
 
 /// How [`Protocol::run_until_cancelled`] ended.
@@ -706,6 +718,7 @@ impl Protocol {
             settings,
             dataset,
             models,
+            runner: Runner::default(),
         })
     }
 
@@ -729,6 +742,13 @@ impl Protocol {
     /// `factory` (instead of what the settings name).
     pub fn with_environment(mut self, factory: SharedEnvironmentFactory) -> Self {
         self.environment = factory;
+        self
+    }
+
+    /// The same protocol with its episodes run by `runner` (e.g.
+    /// `Runner::new(threads)`); the records do not depend on it.
+    pub fn with_runner(mut self, runner: Runner) -> Self {
+        self.runner = runner;
         self
     }
 
@@ -903,10 +923,9 @@ impl Protocol {
         })
     }
 
-    /// Runs every job in parallel (rayon's pool: `RAYON_NUM_THREADS` or
-    /// all cores), calling `progress(done, total)` after each, and returns
-    /// the records in job order. The first failing run's error is returned,
-    /// naming the run.
+    /// Runs every job in parallel on the protocol's [`Runner`], calling
+    /// `progress(done, total)` after each, and returns the records in job
+    /// order. The first failing run's error is returned, naming the run.
     pub fn run_all(&self, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Vec<RunRecord>> {
         match self.run_until_cancelled(progress, &AtomicBool::new(false))? {
             RunOutcome::Finished(records) => Ok(records),
@@ -943,21 +962,19 @@ impl Protocol {
         }
         let total = jobs.len();
         let done = AtomicUsize::new(0);
-        // `None`: cancelled (rayon stops handing out jobs at the first).
-        let records: Option<Result<Vec<RunRecord>>> = jobs
-            .par_iter()
-            .map(|key| {
-                if cancel.load(Ordering::Relaxed) {
-                    return None;
-                }
-                let r = self.run_one(key, &ctx).map_err(|e| self.in_run(key, e));
-                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-                Some(r)
-            })
-            .collect();
+        // The runner stops handing out jobs at the first `Stop`.
+        let records = self.runner.map(&jobs, |key| {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(Stop::Cancelled);
+            }
+            let r = self.run_one(key, &ctx).map_err(|e| self.in_run(key, e));
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            r.map_err(Stop::Failed)
+        });
         match records {
-            Some(r) => Ok(RunOutcome::Finished(r?)),
-            None => Ok(RunOutcome::Cancelled {
+            Ok(records) => Ok(RunOutcome::Finished(records)),
+            Err(Stop::Failed(e)) => Err(e),
+            Err(Stop::Cancelled) => Ok(RunOutcome::Cancelled {
                 done: done.into_inner(),
                 total,
             }),

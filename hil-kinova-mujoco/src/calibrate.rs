@@ -4,7 +4,8 @@
 //! Trials cycle through the settings (trial `t` uses `settings[t % n]`), so
 //! 30 trials over the three settings are 10 per setting, as in the
 //! published data set, and the overall rate compares with its `all` row.
-//! Attempts run on `threads` worker threads, each with its own simulator;
+//! Attempts run on `threads` worker threads (a [`hil_jobs::Runner`]), each
+//! with its own simulators;
 //! every attempt's seed depends only on (seed, food, action, trial), so the
 //! result does not depend on the number of threads.
 //!
@@ -29,12 +30,10 @@
 
 use std::collections::HashMap;
 
-use rayon::prelude::*;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use hil_core::{ArmId, Environment, HilError, Result};
+use hil_jobs::Runner;
 use hil_stats::{
     Alternative, Stat, binomial_pmf, binomial_se, binomial_upper_tail, bonferroni, convolve,
     fisher_exact,
@@ -57,7 +56,8 @@ pub struct CalibrationOptions {
     pub trials: usize,
     /// Master seed.
     pub seed: u64,
-    /// Worker threads (each with its own simulator).
+    /// Worker threads, each with its own simulators ([`Runner::new`]: 0 =
+    /// one per core, or `RAYON_NUM_THREADS`).
     pub threads: usize,
     /// The tool. Default [`RollBy::ArmYaw`]: the rigid fork the published
     /// rates were measured with (Feng et al. 2019), so that only the food
@@ -237,15 +237,14 @@ pub fn calibrate_with(
     progress: &(dyn Fn(usize, usize) + Sync),
     log: &mut dyn FnMut(&AttemptRecord),
 ) -> Result<CalibrationReport> {
-    if opts.foods.is_empty() || opts.settings.is_empty() || opts.trials == 0 || opts.threads == 0 {
+    if opts.foods.is_empty() || opts.settings.is_empty() || opts.trials == 0 {
         return Err(HilError::invalid_parameter(
             "calibration",
             format!(
-                "{} foods, {} settings, {} trials, {} threads",
+                "{} foods, {} settings, {} trials",
                 opts.foods.len(),
                 opts.settings.len(),
                 opts.trials,
-                opts.threads
             ),
             "needs at least one of each",
         ));
@@ -259,61 +258,49 @@ pub fn calibrate_with(
         })
         .collect();
     let total = jobs.len();
-    let done = AtomicUsize::new(0);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
-        .build()
-        .map_err(|e| HilError::state("kinova calibrate", e.to_string()))?;
+    let runner = Runner::new(opts.threads)?;
     // One set of simulators per worker thread, kept across its jobs
     // (building a MuJoCo scene costs far more than an attempt).
     type Scenes = HashMap<(FoodKind, Setting), KinovaFeedingEnv>;
-    let scenes: Vec<Mutex<Scenes>> = (0..opts.threads).map(|_| Mutex::default()).collect();
-    let attempt = |&(food, a, t): &(FoodKind, usize, usize)| -> Result<AttemptRecord> {
-        let worker = rayon::current_thread_index().unwrap_or(0) % scenes.len();
-        let mut envs = lock(&scenes[worker]);
-        let setting = opts.settings[t % opts.settings.len()];
-        let env = match envs.entry((food, setting)) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                e.insert(KinovaFeedingEnv::new(KinovaFeedingConfig {
-                    plate: vec![food.name().to_string()],
-                    settings: vec![setting.name().to_string()],
-                    roll_by: opts.roll_by,
-                    ..KinovaFeedingConfig::default()
-                })?)
-            }
+    let attempt =
+        |envs: &mut Scenes, &(food, a, t): &(FoodKind, usize, usize)| -> Result<AttemptRecord> {
+            let setting = opts.settings[t % opts.settings.len()];
+            let env = match envs.entry((food, setting)) {
+                std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(KinovaFeedingEnv::new(KinovaFeedingConfig {
+                        plate: vec![food.name().to_string()],
+                        settings: vec![setting.name().to_string()],
+                        roll_by: opts.roll_by,
+                        ..KinovaFeedingConfig::default()
+                    })?)
+                }
+            };
+            let seed = trial_seed(opts.seed, food, a, t);
+            env.reset(seed)?;
+            env.next_item()?;
+            env.observe()?;
+            env.execute(ArmId(a))?;
+            let report = env
+                .last_attempt()
+                .cloned()
+                .ok_or_else(|| HilError::state("kinova calibrate", "an attempt left no report"))?;
+            Ok(AttemptRecord {
+                food,
+                setting,
+                trial: t,
+                seed,
+                report,
+            })
         };
-        let seed = trial_seed(opts.seed, food, a, t);
-        env.reset(seed)?;
-        env.next_item()?;
-        env.observe()?;
-        env.execute(ArmId(a))?;
-        let report = env
-            .last_attempt()
-            .cloned()
-            .ok_or_else(|| HilError::state("kinova calibrate", "an attempt left no report"))?;
-        progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-        Ok(AttemptRecord {
-            food,
-            setting,
-            trial: t,
-            seed,
-            report,
-        })
-    };
     // Records come back in job order; the first error stops the run.
-    let records: Vec<AttemptRecord> =
-        pool.install(|| jobs.par_iter().map(attempt).collect::<Result<_>>())?;
+    let (records, scenes) = runner.map_per_worker(&jobs, Scenes::new, attempt, progress)?;
     let mut timing = (Duration::ZERO, Duration::ZERO);
     let mut cpu = Duration::ZERO;
     let mut steps = 0u64;
     let mut hold_s = crate::sim::PUBLISHED_HOLD;
-    for envs in scenes {
-        for env in envs
-            .into_inner()
-            .unwrap_or_else(|e| e.into_inner())
-            .values()
-        {
+    for envs in &scenes {
+        for env in envs.values() {
             let t = env.simulator().timing();
             timing.0 += t.in_step;
             timing.1 += t.total;
@@ -378,7 +365,7 @@ pub fn calibrate_with(
         ),
         attempts_per_second: total as f64 / wall.max(1e-9),
         attempts_per_second_per_core: total as f64 / cpu.as_secs_f64().max(1e-9),
-        threads: opts.threads,
+        threads: runner.threads(),
         overhead_share: 1.0 - in_step.as_secs_f64() / busy.as_secs_f64().max(1e-9),
         rows,
         note: "simulated (MuJoCo) attempts with synthetic food properties; published rates: Feng et al. 2019 (settings isolated, wall, lettuce; `all` is their mean)",
@@ -622,10 +609,6 @@ impl Consistency {
             smallest_p_adjusted: bonferroni(smallest_p, tested.len()),
         }
     }
-}
-
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// Trials, discarded trials and successes among some attempts, and the

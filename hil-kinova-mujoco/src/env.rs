@@ -170,6 +170,31 @@ impl KinovaFeedingConfig {
     }
 }
 
+impl KinovaFeedingEnv {
+    /// The scene `config` describes when it is a `kinova_feeding` config
+    /// (found by its `type` key), built with its paths resolved from `ctx`;
+    /// `None` for any other environment. A caller that needs the concrete
+    /// scene, e.g. to record keyframes around its attempts, gets it here
+    /// rather than as the boxed `dyn Environment` the config builds.
+    pub fn from_component(
+        config: &dyn EnvironmentConfig,
+        ctx: &BuildContext,
+    ) -> Result<Option<Self>> {
+        let mut value =
+            serde_json::to_value(config).map_err(|e| HilError::serde("environment", e))?;
+        let Some(table) = value.as_object_mut() else {
+            return Ok(None);
+        };
+        if table.get("type").and_then(serde_json::Value::as_str) != Some("kinova_feeding") {
+            return Ok(None);
+        }
+        table.remove("type");
+        let scene: KinovaFeedingConfig =
+            serde_json::from_value(value).map_err(|e| HilError::serde("environment", e))?;
+        Self::new(scene.resolved(ctx)).map(Some)
+    }
+}
+
 impl KinovaFeedingConfig {
     /// This config with a custom scene (`mjcf`) resolved against the
     /// config file's directory, as every build from `ctx` needs it.

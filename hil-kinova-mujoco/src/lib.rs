@@ -6,8 +6,11 @@
 //!
 //! - [`KinovaFeedingEnv`], the `hil_core::Environment`, and its config
 //!   type `kinova_feeding` ([`KinovaFeedingConfig`]);
+//!   [`KinovaFeedingEnv::from_component`] finds the concrete scene behind
+//!   any environment config;
 //! - [`calibrate`] / [`calibrate_with`]: success rates per (food, action)
-//!   beside the published ones;
+//!   beside the published ones; [`AttemptLog`]: every attempt as JSON
+//!   lines;
 //! - [`Simulator`]: one simulated attempt from placement to hold
 //!   ([`Placement`], [`PerceivedTarget`], [`AttemptReport`]), on our own
 //!   MJCF of the Gen3 6-DoF arm with the 2-DoF feeding fork or on a scene
@@ -28,6 +31,8 @@
 //! fails with [`hil_core::HilError::Unsupported`] saying so, so that
 //! `cargo test --workspace` passes with only the Rust toolchain.
 
+#[cfg(feature = "physics")]
+mod attempt_log;
 #[cfg(feature = "physics")]
 mod calibrate;
 #[cfg(feature = "physics")]
@@ -51,6 +56,8 @@ mod skewer;
 #[cfg(not(feature = "physics"))]
 mod without_physics;
 
+#[cfg(feature = "physics")]
+pub use attempt_log::AttemptLog;
 #[cfg(feature = "physics")]
 pub use calibrate::{
     AttemptRecord, CalibrationOptions, CalibrationOverSeeds, CalibrationReport, CalibrationRow,

@@ -12,6 +12,7 @@
 //! - [`registry`]: Python factories as named component types;
 //! - [`session`]: the session loop with its record and resume;
 //! - [`reproduce`]: the paper's simulated protocol;
+//! - [`user_study`]: the paper's user-study protocol on any environment;
 //! - [`interrupt`]: long work that Ctrl-C stops and that reports progress;
 //! - [`workload`]: the study loader, fitting and model selection;
 //! - [`testing`]: the conformance suites.
@@ -29,6 +30,7 @@ mod reproduce;
 mod session;
 mod sweep;
 mod testing;
+mod user_study;
 mod workload;
 
 /// The native module. The Python package re-exports its public names.
@@ -51,5 +53,6 @@ fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
     testing::register(m)?;
     gym::register(m)?;
     sweep::register(m)?;
+    user_study::register(m)?;
     Ok(())
 }

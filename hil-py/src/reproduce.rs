@@ -279,9 +279,9 @@ fn component_table(
 ///
 /// `out` also writes the tables, figures and results.json there (as `hil
 /// reproduce --out`); `records=True` adds every run's record under
-/// `"records"`. Runs on rayon's pool (`RAYON_NUM_THREADS`) with the GIL
-/// released; Ctrl-C stops it within about one episode per thread
-/// (`KeyboardInterrupt`). `progress`: a callable `progress(done, total)`
+/// `"records"`. Runs on the default `hil_jobs::Runner` (`RAYON_NUM_THREADS`,
+/// else one worker per core) with the GIL released; Ctrl-C stops it within
+/// about one episode per thread (`KeyboardInterrupt`). `progress`: a callable `progress(done, total)`
 /// called on this thread as runs finish, or `True` for a line on stderr.
 #[pyfunction]
 #[pyo3(signature = (settings=None, *, quick=false, seed=None, many_seeds=None, extra_methods=None, channel=None, environment=None, workload_models=None, out=None, records=false, progress=None))]
@@ -329,7 +329,7 @@ pub(crate) fn reproduce(
             setup_s,
             runs_s: t1.elapsed().as_secs_f64(),
             report_s: 0.0,
-            threads: rayon_threads(),
+            threads: protocol.runner.threads(),
         };
         let (reproduction, _) = report(&protocol, &runs, out.as_deref(), &mut timing)?;
         hil_core::Result::Ok(Ok((reproduction, runs)))
@@ -350,15 +350,6 @@ pub(crate) fn cancelled((done, total): (usize, usize)) -> PyErr {
     pyo3::exceptions::PyKeyboardInterrupt::new_err(format!(
         "the protocol was cancelled after {done} of {total} runs"
     ))
-}
-
-/// The worker threads rayon's global pool uses.
-fn rayon_threads() -> usize {
-    std::env::var("RAYON_NUM_THREADS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .filter(|&n| n > 0)
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

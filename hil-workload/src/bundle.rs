@@ -3,6 +3,8 @@
 //! `hil workload bundle` runs [`build_bundle`] on [`bundled_study`] and
 //! writes `data/synthetic_study.csv` and `models/*.json`.
 
+use std::path::Path;
+
 use hil_core::{HilError, Result};
 use hil_stats::{Alternative, StatsError, TestResult, mann_whitney_u, mean, mean_std};
 use serde::{Deserialize, Serialize};
@@ -126,4 +128,39 @@ pub fn build_bundle(
         ));
     }
     Ok((table, models))
+}
+
+/// What every output made from the bundled synthetic study says about its
+/// data.
+pub const SYNTHETIC_DATA_NOTE: &str = "Data: synthetic study calibrated to the paper's published figures (not real participant data).";
+
+/// What [`write_bundle`] wrote.
+#[derive(Clone, Debug)]
+pub struct WrittenBundle {
+    /// The regenerated study's summary (also written to `data/summary.txt`).
+    pub summary: StudySummary,
+    /// The study-fitted models, as written to `models/<name>.json`.
+    pub models: Vec<FittedModel>,
+}
+
+/// Regenerates the bundle in the hil-workload crate folder `dir`: the
+/// synthetic study (`data/synthetic_study.csv`), its summary and selection
+/// table (`data/summary.txt`, `data/selection.{md,csv}`) and the
+/// study-fitted models ([`build_bundle`], `models/<name>.json`).
+pub fn write_bundle(dir: &Path, opts: &SelectOptions) -> Result<WrittenBundle> {
+    let study = bundled_study()?;
+    study.write_csv(&dir.join("data/synthetic_study.csv"))?;
+    let summary = StudySummary::of(&study)?;
+    let (table, models) = build_bundle(&study, "hil-workload/data/synthetic_study.csv", opts)?;
+    let write = |name: &str, text: &str| hil_core::files::write_text(&dir.join(name), text);
+    write(
+        "data/selection.md",
+        &format!("{}\n{SYNTHETIC_DATA_NOTE}\n", table.to_markdown()),
+    )?;
+    write("data/selection.csv", &table.to_csv())?;
+    write("data/summary.txt", &summary.to_text())?;
+    for m in &models {
+        m.save(dir.join(format!("models/{}.json", m.name)))?;
+    }
+    Ok(WrittenBundle { summary, models })
 }

@@ -12,6 +12,7 @@
 //!   Exp-Impulse, and the versioned JSON model file;
 //! - [`fit`]: exact ridge and box-constrained least squares;
 //! - [`select`]: nested cross-validation and the appendix table;
+//! - [`rollout`]: a model's workload over a query schedule;
 //! - [`stats`]: Mann-Whitney U and Wilcoxon signed-rank tests;
 //! - [`synth`]: a synthetic study calibrated to the paper's figures;
 //! - [`demo_counting`]: a simple counting model for demos (`demo_counting`);
@@ -36,6 +37,7 @@ pub mod demo_counting;
 pub mod features;
 pub mod fit;
 pub mod models;
+pub mod rollout;
 pub mod seeds;
 pub mod select;
 pub mod study;

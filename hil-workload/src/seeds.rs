@@ -85,13 +85,11 @@ pub struct SeedSpread {
 }
 
 impl SeedSpread {
-    /// Generates one study per seed in `seeds` (in parallel on rayon's pool).
+    /// Generates one study per seed in `seeds` (in parallel on the default
+    /// [`hil_jobs::Runner`]).
     pub fn over(config: &SynthConfig, seeds: Range<u64>) -> Result<Self> {
-        use rayon::prelude::*;
-        let draws: Vec<Draw> = seeds
-            .into_par_iter()
-            .map(|s| Draw::of(config, s))
-            .collect::<Result<_>>()?;
+        let seeds: Vec<u64> = seeds.collect();
+        let draws: Vec<Draw> = hil_jobs::Runner::default().map(&seeds, |&s| Draw::of(config, s))?;
         let col = |f: &dyn Fn(&Draw) -> f64| Stat::of(&draws.iter().map(f).collect::<Vec<_>>());
         let ps: Vec<f64> = draws.iter().map(|d| d.p).collect();
         let p_median = hil_stats::median(&ps);

@@ -11,7 +11,7 @@
 //! every training set's equations are sums (or differences) of them. Designs
 //! for shorter histories are prefixes. Folds run on all cores.
 
-use rayon::prelude::*;
+use hil_jobs::Runner;
 use std::fmt::Write as _;
 
 use hil_core::{HilError, Result};
@@ -42,7 +42,7 @@ pub struct SelectOptions {
     pub inner_folds: usize,
     /// Seed of the fold assignment.
     pub seed: u64,
-    /// Worker threads (0 = all cores).
+    /// Worker threads ([`hil_jobs::Runner::new`]: 0 = one per core, or `RAYON_NUM_THREADS`).
     pub threads: usize,
 }
 
@@ -482,32 +482,21 @@ pub fn cross_validate(
     let tasks: Vec<(usize, usize)> = (0..datasets.len())
         .flat_map(|d| (0..opts.outer_folds).map(move |o| (d, o)))
         .collect();
-    let threads = if opts.threads == 0 {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    } else {
-        opts.threads
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.min(tasks.len()).max(1))
-        .build()
-        .map_err(|e| HilError::state("model selection", e.to_string()))?;
     // Results come back in task order, whatever the thread count.
-    let flat: Vec<(usize, usize, FoldScores)> = pool.install(|| {
-        tasks
-            .par_iter()
-            .map(|&(d, o)| -> Result<(usize, usize, FoldScores)> {
-                let (train, inner, test) = fold_layout(o, opts.outer_folds, opts.inner_folds);
-                let p = &problems[d];
-                let split = p.split(&train, &inner);
-                let mut scores = Vec::with_capacity(candidates.len());
-                for &c in candidates {
-                    let (spec, lambda) = p.fit(c, &split, &opts.lambdas)?;
-                    scores.push((p.test_mse(&test, &spec)?, lambda));
-                }
-                Ok((d, o, scores))
-            })
-            .collect::<Result<_>>()
-    })?;
+    let flat: Vec<(usize, usize, FoldScores)> = Runner::new(opts.threads)?.map(
+        &tasks,
+        |&(d, o)| -> Result<(usize, usize, FoldScores)> {
+            let (train, inner, test) = fold_layout(o, opts.outer_folds, opts.inner_folds);
+            let p = &problems[d];
+            let split = p.split(&train, &inner);
+            let mut scores = Vec::with_capacity(candidates.len());
+            for &c in candidates {
+                let (spec, lambda) = p.fit(c, &split, &opts.lambdas)?;
+                scores.push((p.test_mse(&test, &spec)?, lambda));
+            }
+            Ok((d, o, scores))
+        },
+    )?;
     let mut per: Vec<Vec<FoldScores>> = vec![vec![Vec::new(); candidates.len()]; datasets.len()];
     for (d, _, scores) in flat {
         for (c, s) in scores.into_iter().enumerate() {
@@ -668,6 +657,23 @@ impl SelectionTable {
             }
         }
         v
+    }
+
+    /// Writes the table as `selection.md`, `selection.csv` and
+    /// `selection.json` into `dir` (created if needed); returns their paths.
+    pub fn write_to(&self, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>> {
+        let files = [
+            ("selection.md", self.to_markdown()),
+            ("selection.csv", self.to_csv()),
+            ("selection.json", self.to_json()),
+        ];
+        let mut written = Vec::new();
+        for (name, text) in files {
+            let path = dir.join(name);
+            hil_core::files::write_text(&path, &text)?;
+            written.push(path);
+        }
+        Ok(written)
     }
 
     /// The table in Markdown (bold: the winner per dataset).

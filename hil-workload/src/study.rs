@@ -507,6 +507,12 @@ impl Study {
         &self.source
     }
 
+    /// Writes the study as CSV ([`Study::to_csv`]) to `path`, creating its
+    /// folder if needed.
+    pub fn write_csv(&self, path: &Path) -> Result<()> {
+        hil_core::files::write_text(path, &self.to_csv())
+    }
+
     /// Renders the study as CSV in the documented format (RFC 4180: a
     /// field is quoted only if it needs to be).
     pub fn to_csv(&self) -> String {

@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-use hil_core::HilError;
 use hil_envs::dataset::FoodDataset;
 use hil_envs::generate::SyntheticFoods;
 use hil_envs::rates::PublishedRates;
@@ -80,18 +79,8 @@ fn generate(a: GenerateArgs) -> hil_core::Result<()> {
     if let Some(n) = a.images_per_setting {
         g.images_per_setting = n;
     }
-    let non_empty = std::fs::read_dir(&a.out).is_ok_and(|mut d| d.next().is_some());
-    if non_empty && !a.force {
-        return Err(HilError::invalid_input(
-            format!("output directory {}", a.out.display()),
-            "it is not empty; pass --force to overwrite",
-        ));
-    }
-    let out = g.generate()?;
-    let manifest = out.save(&a.out)?;
-    let params = toml::to_string_pretty(&g).map_err(|e| HilError::serde("generator", e))?;
-    let p = a.out.join("generator.toml");
-    std::fs::write(&p, params).map_err(|e| HilError::io("writing", &p, e))?;
+    let written = g.write_into(&a.out, a.force)?;
+    let (out, manifest, p) = (&written.generated, &written.manifest, &written.parameters);
     println!(
         "wrote {} ({} foods, {} images, d = {}); generator parameters in {}",
         manifest.display(),

@@ -13,15 +13,13 @@
 //!   n_success and n_q per plate and their mean ± standard error per method.
 //!   This file only reads arguments, renders keyframes and prints.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use hil_core::{HilError, Result};
-use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyResult};
+use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyOverSeeds, UserStudyResult};
 use hil_kinova_mujoco::{
-    CalibrationOptions, CalibrationReport, CalibrationRow, Consistency, FoodKind, KeyframeRecorder,
-    KeyframeWriter, KinovaFeedingConfig, KinovaFeedingEnv, Label, RenderingEnv, RollBy,
-    calibrate_over_seeds, parse_labels,
+    AttemptLog, CalibrationOptions, CalibrationReport, CalibrationRow, Consistency, FoodKind,
+    Label, RollBy, calibrate_over_seeds, parse_labels,
 };
 
 /// Arguments of `hil kinova`.
@@ -60,9 +58,8 @@ pub struct CalibrateArgs {
     /// Placement settings the trials cycle through (default: isolated,wall,lettuce).
     #[arg(long, value_delimiter = ',')]
     pub settings: Vec<String>,
-    /// Worker threads, each with its own simulator (default: one per core).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub threads: super::Threads,
     /// Write every attempt (setting, seed, stop reason, forces, tine
     /// counts, heights) to this file as JSON lines.
     #[arg(long)]
@@ -113,9 +110,8 @@ pub struct KinovaDemoArgs {
     /// standard error over the seeds.
     #[arg(long, default_value_t = 1)]
     pub seeds: usize,
-    /// Worker threads for --seeds (default: one per core).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub threads: super::Threads,
     /// Write PNG keyframes of every attempt into this directory (offscreen
     /// EGL; needs the `kinova_feeding` environment).
     #[arg(long)]
@@ -180,13 +176,6 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             "must be at least 1",
         ));
     }
-    if args.threads == Some(0) {
-        return Err(HilError::invalid_parameter(
-            "--threads",
-            "0",
-            "must be at least 1",
-        ));
-    }
     let roll_by = RollBy::parse(&args.roll_by).ok_or_else(|| {
         HilError::invalid_parameter(
             "--roll-by",
@@ -204,9 +193,7 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         settings: labels_or_all("--settings", &args.settings)?,
         trials: args.trials,
         seed: args.seed,
-        threads: args
-            .threads
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        threads: args.threads.threads,
     };
     let quiet = args.quiet;
     let runs = args.seeds;
@@ -223,28 +210,21 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             }
         }
     };
-    // Create the attempt log before the run, so a bad path fails at once.
-    let log_file = match &args.attempts {
-        Some(path) => Some((
-            path,
-            std::fs::File::create(path).map_err(|e| HilError::io("create", path, e))?,
-        )),
-        None => None,
-    };
+    // Created before the run, so a bad path fails at once.
+    let log = args
+        .attempts
+        .as_deref()
+        .map(AttemptLog::create)
+        .transpose()?;
     let seeds: Vec<u64> = (0..args.seeds).map(|i| args.seed.wrapping_add(i)).collect();
     let mut records = Vec::new();
     let mut over = calibrate_over_seeds(&opts, &seeds, &progress, &mut |r| {
-        if log_file.is_some() {
+        if log.is_some() {
             records.push(r.clone());
         }
     })?;
-    if let Some((path, file)) = log_file {
-        let mut w = std::io::BufWriter::new(file);
-        for r in &records {
-            let line = serde_json::to_string(r).map_err(|e| HilError::serde("attempt", e))?;
-            writeln!(w, "{line}").map_err(|e| HilError::io("write", path, e))?;
-        }
-        w.flush().map_err(|e| HilError::io("write", path, e))?;
+    if let Some(log) = log {
+        log.write(&records)?;
     }
     if over.runs.len() == 1 {
         let report = over.runs.remove(0);
@@ -474,32 +454,10 @@ fn demo_config(args: &KinovaDemoArgs) -> Result<UserStudyConfig> {
     Ok(cfg)
 }
 
-/// The `[environment]` as the concrete MuJoCo scene, when it is one:
-/// keyframes are recorded around the scene's own attempts.
-fn kinova_scene(cfg: &UserStudyConfig, base: &Path) -> Result<Option<KinovaFeedingEnv>> {
-    let mut value =
-        toml::Value::try_from(&cfg.environment).map_err(|e| HilError::serde("environment", e))?;
-    let Some(table) = value.as_table_mut() else {
-        return Ok(None);
-    };
-    if table.get("type").and_then(toml::Value::as_str) != Some("kinova_feeding") {
-        return Ok(None);
-    }
-    table.remove("type");
-    let scene: KinovaFeedingConfig = value
-        .try_into()
-        .map_err(|e| HilError::serde("environment", e))?;
-    KinovaFeedingEnv::new(scene.resolved(&cfg.context(base))).map(Some)
-}
-
 fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
-    if args.seeds == 0 || args.threads == Some(0) {
+    if args.seeds == 0 {
         return Err(HilError::invalid_parameter(
-            if args.seeds == 0 {
-                "--seeds"
-            } else {
-                "--threads"
-            },
+            "--seeds",
             0,
             "must be at least 1",
         ));
@@ -508,96 +466,41 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
         return demo_many_seeds(&args);
     }
     let cfg = demo_config(&args)?;
-    let base = components_dir(&args);
     let quiet = args.quiet;
     if !quiet {
         eprintln!("building the environment and its pretraining data (once, for every method)");
     }
-    let progress = |plate: &Plate| {
-        if !quiet {
-            eprintln!(
-                "repetition {} plate {}: {}",
-                plate.repetition, plate.position, plate.label
-            );
-        }
-    };
-    let scene = match &args.render {
-        Some(_) => kinova_scene(&cfg, &base)?,
-        None => None,
-    };
-    let mut writer = None;
-    let result = match scene {
-        Some(mut env) => {
-            writer = match args
-                .render
-                .as_deref()
-                .map(|d| KeyframeWriter::new(d, env.simulator()))
-            {
-                Some(Ok(w)) => Some(w),
-                Some(Err(why)) => {
-                    eprintln!("note: rendering unavailable ({why}); continuing without pictures");
-                    None
-                }
-                None => None,
-            };
-            let mut recorder = KeyframeRecorder::default();
-            let mut study = cfg.prepare(&base, &env)?;
-            study.run_with(
-                &mut env,
-                |plate, env, episode| {
-                    progress(plate);
-                    // Validation plates (repetition 0) are not pictured.
-                    let Some(w) = writer.as_mut().filter(|_| plate.repetition > 0) else {
-                        return episode(env, &mut []);
-                    };
-                    recorder.set_prefix(format!("rep{}_{}", plate.repetition, slug(&plate.label)));
-                    let report = episode(&mut RenderingEnv::new(env, &mut recorder), &mut [])?;
-                    if let Err(why) = w.write(&mut recorder) {
-                        eprintln!("note: {why}; continuing without pictures");
-                        writer = None;
-                    }
-                    Ok(report)
-                },
-                |_| {},
-            )?
-        }
-        None => {
-            if args.render.is_some() {
+    let run = cfg.run_pictured(
+        &components_dir(&args),
+        args.render.as_deref(),
+        &mut |plate: &Plate| {
+            if !quiet {
                 eprintln!(
-                    "note: rendering needs the `kinova_feeding` environment; continuing without pictures"
+                    "repetition {} plate {}: {}",
+                    plate.repetition, plate.position, plate.label
                 );
             }
-            let mut env = cfg.build_environment(&base)?;
-            let mut study = cfg.prepare(&base, env.as_ref())?;
-            study.run_with(
-                env.as_mut(),
-                |plate, env, episode| {
-                    progress(plate);
-                    episode(env, &mut [])
-                },
-                |_| {},
-            )?
-        }
-    };
-    print_result(&result, args.json)?;
-    if let Some(w) = writer {
-        eprintln!("wrote {} keyframes to {}", w.written(), w.dir().display());
+        },
+        &mut |note| eprintln!("note: {note}"),
+    )?;
+    print_result(&run.result, args.json)?;
+    if let Some(k) = run.keyframes {
+        eprintln!("wrote {} keyframes to {}", k.written, k.dir.display());
     }
     Ok(())
 }
 
-/// A label as a file-name part: `LinUCB-QG` becomes `linucb_qg`.
-fn slug(label: &str) -> String {
-    label
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() {
-                c.to_ascii_lowercase()
-            } else {
-                '_'
-            }
-        })
-        .collect()
+/// `value`'s JSON object with the [`NOTE`] beside its fields, printed.
+fn print_json_with_note(value: &impl serde::Serialize) -> Result<()> {
+    let mut out = serde_json::to_value(value).map_err(|e| HilError::serde("demo report", e))?;
+    if let Some(fields) = out.as_object_mut() {
+        fields.insert("note".into(), NOTE.into());
+    }
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
+    );
+    Ok(())
 }
 
 /// `12.3 ± 0.4`, or the mean alone where one plate leaves the error undefined.
@@ -610,18 +513,7 @@ fn pm(mean: f64, sem: Option<f64>, digits: usize) -> String {
 
 fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
     if json {
-        let out = serde_json::json!({
-            "protocol": result.protocol,
-            "plates": result.plates,
-            "methods": result.methods,
-            "selections": result.selections,
-            "note": NOTE,
-        });
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
-        );
-        return Ok(());
+        return print_json_with_note(result);
     }
     let p = &result.protocol;
     println!(
@@ -695,7 +587,6 @@ fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
 /// `hil demo kinova --seeds N`: the whole study on N consecutive master
 /// seeds (in parallel), every figure as mean ± standard error over seeds.
 fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
-    use hil_experiments::user_study::across_seeds;
     if args.render.is_some() {
         return Err(HilError::invalid_parameter(
             "--render",
@@ -703,66 +594,39 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
             "pictures are written for a single seed; drop --seeds or --render",
         ));
     }
-    let base_cfg = demo_config(args)?;
-    let base = components_dir(args);
-    let threads = args
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .min(args.seeds);
-    let first = base_cfg.seed;
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let results = std::sync::Mutex::new(Vec::new());
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    if i >= args.seeds {
-                        break;
-                    }
-                    let run = demo_config(args).and_then(|mut cfg| {
-                        cfg.seed = first.wrapping_add(i as u64);
-                        cfg.run(&base, |_| {})
-                    });
-                    if !args.quiet {
-                        eprintln!("seed {} done", first.wrapping_add(i as u64));
-                    }
-                    results
-                        .lock()
-                        .unwrap_or_else(|e| e.into_inner())
-                        .push((i, run));
-                }
-            });
-        }
-    });
-    let mut runs = results.into_inner().unwrap_or_else(|e| e.into_inner());
-    runs.sort_by_key(|(i, _)| *i);
-    let runs: Vec<UserStudyResult> = runs.into_iter().map(|(_, r)| r).collect::<Result<_>>()?;
-    let rows = across_seeds(&runs);
-    let mut chosen = Vec::new();
-    for sel in runs.iter().flat_map(|r| &r.selections) {
-        chosen.push((sel.method.clone(), sel.parameter.clone(), sel.chosen));
-    }
+    let cfg = demo_config(args)?;
+    let first = cfg.seed;
+    let seeds: Vec<u64> = (0..args.seeds as u64)
+        .map(|i| first.wrapping_add(i))
+        .collect();
+    let quiet = args.quiet;
+    let over = cfg.run_over_seeds(
+        &components_dir(args),
+        &seeds,
+        &args.threads.runner()?,
+        &|seed| {
+            if !quiet {
+                eprintln!("seed {seed} done");
+            }
+        },
+    )?;
     if args.json {
-        let out = serde_json::json!({
-            "seeds": (first..first + args.seeds as u64).collect::<Vec<_>>(),
-            "methods": rows,
-            "selections": runs.iter().map(|r| &r.selections).collect::<Vec<_>>(),
-            "protocol": runs[0].protocol,
-            "note": NOTE,
-        });
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
-        );
-        return Ok(());
+        return print_json_with_note(&over);
     }
-    let p = &runs[0].protocol;
+    print_over_seeds(&over);
+    Ok(())
+}
+
+/// The study over seeds as text.
+fn print_over_seeds(over: &UserStudyOverSeeds) {
+    let (seeds, rows) = (&over.seeds, &over.methods);
+    let first = seeds[0];
+    let p = &over.protocol;
     println!(
         "User-study protocol in simulation over {} seeds ({}..={}): {}: {}; N_att = {}; {} repetitions per seed.",
-        args.seeds,
+        seeds.len(),
         first,
-        first + args.seeds as u64 - 1,
+        first + seeds.len() as u64 - 1,
         p.environment,
         p.foods.join(", "),
         p.n_att,
@@ -772,7 +636,7 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
     println!(
         "per method: mean ± standard error over seeds (each seed's mean over its plates); paper's real study in brackets"
     );
-    for row in &rows {
+    for row in rows {
         let paper = row.paper.map_or(String::new(), |p| {
             format!(" [{:.2} / {:.2} / {:.2}]", p[0], p[1], p[2])
         });
@@ -786,7 +650,7 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
         );
     }
     println!("where each method asks: queries per plate at each food, and at each attempt index");
-    for row in &rows {
+    for row in rows {
         let foods: Vec<String> = row
             .n_q_per_plate_by_food
             .iter()
@@ -805,24 +669,17 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
             attempts.join(", ")
         );
     }
-    let mut methods: Vec<&String> = chosen.iter().map(|c| &c.0).collect();
-    methods.dedup();
-    for m in methods {
-        let vals: Vec<f64> = chosen.iter().filter(|c| &c.0 == m).map(|c| c.2).collect();
-        let param = &chosen
-            .iter()
-            .find(|c| &c.0 == m)
-            .map(|c| c.1.clone())
-            .unwrap_or_default();
-        let ms = hil_stats::Stat::of(&vals);
+    for c in over.chosen() {
         println!(
-            "{m} {param} chosen on validation (highest mean M_wt) per seed: {} (mean {})",
-            vals.iter()
+            "{} {} chosen on validation (highest mean M_wt) per seed: {} (mean {})",
+            c.method,
+            c.parameter,
+            c.values
+                .iter()
                 .map(|v| v.to_string())
                 .collect::<Vec<_>>()
                 .join(", "),
-            pm(ms.mean, ms.sem(), 2)
+            pm(c.mean.mean, c.mean.sem(), 2)
         );
     }
-    Ok(())
 }

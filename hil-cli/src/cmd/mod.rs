@@ -14,14 +14,21 @@ pub mod run;
 pub mod study;
 pub mod workload;
 
-/// A rayon pool of `threads` workers (default: all cores) and its size.
-pub fn worker_pool(threads: Option<usize>) -> hil_core::Result<(rayon::ThreadPool, usize)> {
-    let threads = threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .max(1);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| hil_core::HilError::state("thread pool", e.to_string()))?;
-    Ok((pool, threads))
+/// `--threads`, defined once so that it means the same in every command
+/// that runs work in parallel (`hil reproduce`, `hil bench reproduce`,
+/// `hil workload select`, `hil kinova calibrate`, `hil demo kinova`): the
+/// size of the one job runner, [`hil_jobs::Runner`].
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct Threads {
+    /// Worker threads; 0 = one per core (RAYON_NUM_THREADS when set).
+    /// Results do not depend on it.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+}
+
+impl Threads {
+    /// The runner of this many threads.
+    pub fn runner(self) -> hil_core::Result<hil_jobs::Runner> {
+        hil_jobs::Runner::new(self.threads)
+    }
 }

@@ -44,9 +44,8 @@ pub struct ReproduceArgs {
     /// Sets `lambda` (ridge strength) in every method whose policy config has one.
     #[arg(long)]
     pub lambda: Option<f64>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub threads: super::Threads,
     /// No progress bar or summary.
     #[arg(long, short)]
     pub quiet: bool,
@@ -77,9 +76,9 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
             }
         }
     }
-    let protocol = Protocol::from_settings(settings)?;
+    let protocol = Protocol::from_settings(settings)?.with_runner(args.threads.runner()?);
     let (settings, dataset) = (&protocol.settings, &protocol.dataset);
-    let (pool, threads) = super::worker_pool(args.threads)?;
+    let threads = protocol.runner.threads();
     let total = protocol.jobs()?.len();
     let setup_s = t0.elapsed().as_secs_f64();
     let bar = if args.quiet {
@@ -95,7 +94,7 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         b
     };
     let t1 = Instant::now();
-    let records = pool.install(|| protocol.run_all(&|done, _| bar.set_position(done as u64)))?;
+    let records = protocol.run_all(&|done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
     let runs_s = t1.elapsed().as_secs_f64();
 

@@ -1,14 +1,14 @@
 //! `hil workload …`: generate study data, select and fit workload models,
 //! roll a model out over a query schedule, regenerate the bundled models.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
-use hil_core::WorkloadInput;
-use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadModel};
-use hil_workload::bundle::{StudySummary, build_bundle, bundled_study};
+use hil_core::{HilError, Result, Timestep};
+use hil_workload::bundle::{SYNTHETIC_DATA_NOTE, StudySummary, WrittenBundle, write_bundle};
 use hil_workload::datasets::DatasetId;
 use hil_workload::models::FittedModel;
+use hil_workload::rollout::{parse_schedule, rollout};
 use hil_workload::select::{Candidate, SelectOptions, fit_study_model, select_study_models};
 use hil_workload::study::Study;
 use hil_workload::synth::SynthConfig;
@@ -143,29 +143,21 @@ struct CvArgs {
     /// Seed of the fold assignment.
     #[arg(long = "cv-seed", default_value_t = 0)]
     cv_seed: u64,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
+    #[command(flatten)]
+    threads: super::Threads,
 }
 
 impl CvArgs {
     fn options(&self) -> SelectOptions {
         SelectOptions {
             seed: self.cv_seed,
-            threads: self.threads,
+            threads: self.threads.threads,
             ..SelectOptions::default()
         }
     }
 }
 
-fn write(path: &Path, text: &str) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| HilError::io("creating", dir, e))?;
-    }
-    std::fs::write(path, text).map_err(|e| HilError::io("writing", path, e))
-}
-
-const SYNTHETIC: &str = "Data: synthetic study calibrated to the paper's published figures (not real participant data).";
+const SYNTHETIC: &str = SYNTHETIC_DATA_NOTE;
 
 /// Runs `hil workload`.
 pub fn run(args: WorkloadArgs) -> Result<()> {
@@ -178,7 +170,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
         } => {
             let cfg = synth_config(config.as_deref())?;
             let study = cfg.generate(seed)?;
-            write(&out, &study.to_csv())?;
+            study.write_csv(&out)?;
             if !quiet {
                 println!(
                     "wrote {} ({} surveys)",
@@ -210,9 +202,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let opts = cv.options();
             let table = select_study_models(&study, &opts)?;
             let elapsed = t0.elapsed();
-            write(&out.join("selection.md"), &table.to_markdown())?;
-            write(&out.join("selection.csv"), &table.to_csv())?;
-            write(&out.join("selection.json"), &table.to_json())?;
+            table.write_to(&out)?;
             if !quiet {
                 print!("{}", table.to_markdown());
                 for id in DatasetId::ALL {
@@ -272,28 +262,22 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 Some(name) => hil_workload::bundled::load_fitted(name)?,
                 None => FittedModel::load(&model)?,
             };
-            hil_core::workload::check_wl0(wl0)?;
             let queries = parse_schedule(&schedule)?;
             let last = queries.last().map_or(0, |q| q.0);
             let end = steps.unwrap_or(last + 10);
-            let mut history = QueryHistory::new();
-            let mut points = Vec::new();
-            let mut qi = 0;
+            let points = rollout(&m, wl0, &queries, end)?;
             println!("t,seconds,wl,query");
-            for t in 0..=end {
-                let mut asked = Vec::new();
-                while qi < queries.len() && queries[qi].0 == t {
-                    history.push(t, queries[qi].1)?;
-                    asked.push(queries[qi].1.to_string());
-                    qi += 1;
-                }
-                let wl = m.predict(&WorkloadInput::new(wl0, &history, t))?;
-                println!("{t},{},{wl:.4},{}", t * 10, asked.join(" "));
-                points.push((t, wl, !asked.is_empty()));
+            for p in &points {
+                let asked: Vec<String> = p.asked.iter().map(ToString::to_string).collect();
+                println!("{},{},{:.4},{}", p.t, p.t * 10, p.wl, asked.join(" "));
             }
             if let Some(path) = svg {
-                let wl: Vec<f64> = points.iter().map(|p| p.1).collect();
-                let asked: Vec<Timestep> = points.iter().filter(|p| p.2).map(|p| p.0).collect();
+                let wl: Vec<f64> = points.iter().map(|p| p.wl).collect();
+                let asked: Vec<Timestep> = points
+                    .iter()
+                    .filter(|p| !p.asked.is_empty())
+                    .map(|p| p.t)
+                    .collect();
                 let title = format!("WL_t of {} (WL_0 = {wl0}); Δt = 10 s", m.name);
                 let note = match (&m.provenance.data, &m.provenance.note) {
                     (_, Some(note)) => note.clone(),
@@ -301,7 +285,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                     (None, None) => "provenance unknown".to_string(),
                 };
                 let svg = hil_experiments::plot::workload_curve_svg(&title, &note, &wl, &asked);
-                write(&path, &svg)?;
+                hil_core::files::write_text(&path, &svg)?;
                 eprintln!("wrote {}", path.display());
             }
             Ok(())
@@ -335,20 +319,18 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
         WorkloadCommand::Calibrate { dir, check } => {
             let models = hil_experiments::calibrate::all()?;
             print!("{}", hil_experiments::calibrate::report(&models)?);
-            let mut stale = Vec::new();
-            for m in models {
-                let path = dir.join(format!("models/{}.json", m.name));
-                if check {
-                    let on_disk =
-                        hil_core::files::read_text(&path, hil_core::files::limits::MODEL)?;
-                    if on_disk != m.to_json() {
-                        stale.push(path.display().to_string());
-                    }
-                } else {
+            if !check {
+                for m in &models {
+                    let path = hil_experiments::calibrate::model_path(&dir, m);
                     m.save(&path)?;
                     eprintln!("wrote {}", path.display());
                 }
+                return Ok(());
             }
+            let stale: Vec<String> = hil_experiments::calibrate::stale_files(&dir, &models)?
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect();
             if !stale.is_empty() {
                 return Err(HilError::invalid_input(
                     "calibrated models",
@@ -362,23 +344,8 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
         }
         WorkloadCommand::Bundle { dir, cv } => {
             let t0 = Instant::now();
-            let study = bundled_study()?;
-            let csv = dir.join("data/synthetic_study.csv");
-            write(&csv, &study.to_csv())?;
-            let summary = StudySummary::of(&study)?;
-            let (table, models) = build_bundle(
-                &study,
-                "hil-workload/data/synthetic_study.csv",
-                &cv.options(),
-            )?;
-            write(
-                &dir.join("data/selection.md"),
-                &format!("{}\n{SYNTHETIC}\n", table.to_markdown()),
-            )?;
-            write(&dir.join("data/selection.csv"), &table.to_csv())?;
-            write(&dir.join("data/summary.txt"), &summary.to_text())?;
+            let WrittenBundle { summary, models } = write_bundle(&dir, &cv.options())?;
             for m in &models {
-                m.save(dir.join(format!("models/{}.json", m.name)))?;
                 println!(
                     "wrote models/{}.json: {}",
                     m.name,
@@ -407,58 +374,4 @@ fn synth_config(path: Option<&std::path::Path>) -> Result<SynthConfig> {
         field: "(json)".into(),
         why: e.to_string(),
     })
-}
-
-/// Parses `t:response/difficulty/distraction,...`.
-fn parse_schedule(s: &str) -> Result<Vec<(Timestep, QueryKind)>> {
-    let mut out: Vec<(Timestep, QueryKind)> = Vec::new();
-    for (i, item) in s
-        .split(',')
-        .map(str::trim)
-        .filter(|x| !x.is_empty())
-        .enumerate()
-    {
-        let bad = |why: String| HilError::invalid_parameter(format!("schedule[{i}]"), item, why);
-        let (t, kind) = item.split_once(':').unwrap_or((item, ""));
-        let t: Timestep = t
-            .trim()
-            .parse()
-            .map_err(|_| bad(format!("`{t}` is not a timestep (non-negative integer)")))?;
-        let k: QueryKind = if kind.trim().is_empty() {
-            QueryKind::default()
-        } else {
-            kind.parse().map_err(|e: HilError| bad(e.to_string()))?
-        };
-        if let Some(prev) = out.last()
-            && t < prev.0
-        {
-            return Err(bad(format!(
-                "times must not decrease (previous query at {})",
-                prev.0
-            )));
-        }
-        out.push((t, k));
-    }
-    Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use hil_core::ResponseType;
-
-    #[test]
-    fn schedule_parsing() {
-        let q = parse_schedule("3:mcq/easy/none, 9:open_ended/hard/easy,9").unwrap();
-        assert_eq!(q.len(), 3);
-        assert_eq!(q[1].1.response, ResponseType::OpenEnded);
-        assert_eq!(q[2].1, QueryKind::default());
-        assert!(
-            parse_schedule("3:telepathy")
-                .unwrap_err()
-                .to_string()
-                .contains("telepathy")
-        );
-        assert!(parse_schedule("5,3").is_err());
-    }
 }

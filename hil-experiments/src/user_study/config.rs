@@ -28,7 +28,8 @@ use serde::{Deserialize, Deserializer, Serialize};
 /// ```
 /// use hil_experiments::user_study::UserStudyConfig;
 /// let cfg = UserStudyConfig::parse(
-///     "repetitions = 1\n[channel]\ntype = \"simulated_expert\"\nerror_rate = 0.1\n",
+///     "repetitions = 1\n[channel]\ntype = \"simulated_expert\"\nerror_rate = 0.1\n\
+///      [environment]\ntype = \"food_replay\"\nfoods = [\"banana\"]\n",
 ///     "study.toml".as_ref(),
 /// )
 /// .unwrap();
@@ -140,15 +141,21 @@ fn paper_session() -> SessionSettings {
         .with_wl0(PAPER_WL0)
         .with_max_items(None)
 }
+/// The paper's scene, `kinova_feeding`, read through its config type as a
+/// study file would name it: in a build without `physics` that type is a
+/// placeholder whose build says how to enable MuJoCo, so the protocol
+/// itself needs no physics.
 fn paper_environment() -> Box<dyn EnvironmentConfig> {
     // As in the study: one item at a time, alone on the plate.
-    Box::new(hil_kinova_mujoco::KinovaFeedingConfig {
-        pretraining_trials: PAPER_PRETRAINING_TRIALS,
-        pretrain_foods: PAPER_PRETRAIN_FOODS.map(String::from).to_vec(),
-        settings: vec!["isolated".into()],
-        neighbours: false,
-        ..Default::default()
-    })
+    let table = serde_json::json!({
+        "type": "kinova_feeding",
+        "pretraining_trials": PAPER_PRETRAINING_TRIALS,
+        "pretrain_foods": PAPER_PRETRAIN_FOODS,
+        "settings": ["isolated"],
+        "neighbours": false,
+    });
+    serde_json::from_value(table)
+        .expect("hil-kinova-mujoco registers `kinova_feeding` in every build")
 }
 fn paper_workload() -> Box<dyn WorkloadModelConfig> {
     Box::new(hil_workload::config::BundledModelConfig {
@@ -201,12 +208,36 @@ impl UserStudyConfig {
     /// assert_eq!((cfg.repetitions, cfg.session.n_att, cfg.seed), (2, 3, 7));
     /// ```
     pub fn paper() -> Self {
+        Self::paper_on(paper_environment())
+    }
+
+    /// The paper's protocol ([`UserStudyConfig::paper`]) on another
+    /// environment: any built-in or plugin environment config, e.g. the
+    /// bundled food dataset's replay, which needs no physics.
+    ///
+    /// ```
+    /// use hil_experiments::user_study::UserStudyConfig;
+    /// let env = hil_envs::FoodReplayConfig {
+    ///     dataset: None,
+    ///     foods: vec!["banana".into(), "carrot".into()],
+    ///     pretrain_foods: vec!["apple".into(), "kiwi".into()],
+    ///     items_per_episode: 3,
+    ///     outcomes: Default::default(),
+    ///     pretrain_reward: Default::default(),
+    /// };
+    /// let mut cfg = UserStudyConfig::paper_on(Box::new(env));
+    /// cfg.repetitions = 1;
+    /// let result = cfg.run(".".as_ref(), |_| {}).unwrap();
+    /// assert_eq!(result.plates.len(), 3);
+    /// assert_eq!(result.protocol.environment, "food_replay");
+    /// ```
+    pub fn paper_on(environment: Box<dyn EnvironmentConfig>) -> Self {
         Self {
             plugins: Vec::new(),
             seed: paper_seed(),
             repetitions: paper_repetitions(),
             session: paper_session(),
-            environment: paper_environment(),
+            environment,
             workload: paper_workload(),
             channel: paper_channel(),
             methods: paper_methods(),
@@ -223,11 +254,24 @@ impl UserStudyConfig {
     /// Parses and validates study TOML; `path` names the file in errors and
     /// is where the `plugins` it lists are resolved from. The plugins are
     /// loaded first, so that plugin types are usable wherever built-in ones
-    /// are. Every error names the file, line and field.
+    /// are. Every error names the file, line and field. A build without
+    /// the `physics` feature refuses a file that names no `[environment]`,
+    /// since the paper's scene is the MuJoCo simulation.
     pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
         load_plugins(text, path)?;
         let cfg: Self = parse_toml(text, path)?;
         cfg.validate_in(text, path)?;
+        if !hil_kinova_mujoco::PHYSICS && !names_environment(text) {
+            return Err(hil_config::error_at_key(
+                text,
+                path,
+                &["environment"],
+                format!(
+                    "name the environment of the study (e.g. `[environment]` with `type = \"food_replay\"`): the default, the MuJoCo `kinova_feeding` scene, cannot run because {}",
+                    hil_kinova_mujoco::ENABLE_PHYSICS
+                ),
+            ));
+        }
         Ok(cfg)
     }
 
@@ -296,6 +340,11 @@ impl UserStudyConfig {
     pub fn to_toml(&self) -> Result<String> {
         toml::to_string(self).map_err(|e| HilError::serde("user-study config", e))
     }
+}
+
+/// Whether study TOML `text` (already parsed once) has an `environment` key.
+fn names_environment(text: &str) -> bool {
+    toml::from_str::<toml::Table>(text).is_ok_and(|t| t.contains_key("environment"))
 }
 
 /// An error at the label of method `index` (0-based): the line of the

@@ -40,19 +40,30 @@
 //! w_task = 0.7
 //! ```
 //!
-//! Run it with [`UserStudyConfig::run`], or, to observe or wrap the
-//! environment per plate (e.g. to render keyframes), build the environment,
+//! Run it with [`UserStudyConfig::run`] on any environment (the default,
+//! the MuJoCo scene, needs the crate feature `physics`; a build without it
+//! refuses a file that names no `[environment]`; [`UserStudyConfig::paper_on`]
+//! is the paper's protocol on another environment), over many seeds in
+//! parallel with [`UserStudyConfig::run_over_seeds`], with PNG keyframes
+//! with `UserStudyConfig::run_pictured` (feature `physics`), or, to observe
+//! or wrap the environment per plate, build the environment,
 //! [`UserStudyConfig::prepare`] the methods and call [`UserStudy::run_with`].
 
 mod config;
+#[cfg(feature = "physics")]
+mod keyframes;
 mod run;
 mod seeds;
 
 pub use config::{
     PAPER_N_ATT, PAPER_VALIDATION_W_TASK, PAPER_W_GRID, PAPER_WORKLOAD, UserStudyConfig, Validation,
 };
+#[cfg(feature = "physics")]
+pub use keyframes::{Keyframes, PicturedStudy};
 pub use run::{
     Episode, MethodSummary, Plate, PlateResult, Protocol, Selection, UserStudy, UserStudyResult,
     method_order,
 };
-pub use seeds::{MethodAcrossSeeds, PAPER_STUDY, across_seeds};
+pub use seeds::{
+    ChosenAcrossSeeds, MethodAcrossSeeds, PAPER_STUDY, UserStudyOverSeeds, across_seeds,
+};

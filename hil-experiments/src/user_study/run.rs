@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use hil_config::TaskContext;
+use hil_config::{BuildContext, TaskContext};
 use hil_core::session::splitmix;
 use hil_core::{
     Environment, EpisodeReport, Policy, Result, Session, SessionObserver, WorkloadModel,
@@ -251,6 +251,8 @@ fn run_plate<E: ?Sized>(
 /// run plates on an environment built from the same config.
 pub struct UserStudy<'c> {
     config: &'c UserStudyConfig,
+    /// The master seed (the config's, or another for a run over seeds).
+    seed: u64,
     ctx: TaskContext,
     policies: Vec<Box<dyn Policy>>,
     workload: Arc<dyn WorkloadModel>,
@@ -261,6 +263,7 @@ impl std::fmt::Debug for UserStudy<'_> {
         f.debug_struct("UserStudy")
             .field("methods", &self.config.labels())
             .field("workload", &self.workload.name())
+            .field("seed", &self.seed)
             .finish()
     }
 }
@@ -272,8 +275,19 @@ impl UserStudyConfig {
     /// space, context dimension and the pretraining data `[environment]`
     /// offers, as in an experiment file.
     pub fn prepare(&self, base_dir: &Path, environment: &dyn Environment) -> Result<UserStudy<'_>> {
+        self.prepare_on_seed(base_dir, environment, self.seed)
+    }
+
+    /// [`UserStudyConfig::prepare`] under master seed `seed` instead of the
+    /// config's.
+    fn prepare_on_seed(
+        &self,
+        base_dir: &Path,
+        environment: &dyn Environment,
+        seed: u64,
+    ) -> Result<UserStudy<'_>> {
         self.validate()?;
-        let base = self.context(base_dir);
+        let base = BuildContext::new(base_dir, seed);
         let ctx = base.describe_environment(self.environment.as_ref(), environment)?;
         let workload = self.workload.build(&base)?;
         let policies = self
@@ -290,6 +304,7 @@ impl UserStudyConfig {
             .collect::<Result<Vec<_>>>()?;
         Ok(UserStudy {
             config: self,
+            seed,
             ctx,
             policies,
             workload,
@@ -321,10 +336,22 @@ impl UserStudyConfig {
     pub fn run(
         &self,
         base_dir: &Path,
+        on_plate: impl FnMut(&PlateResult),
+    ) -> Result<UserStudyResult> {
+        self.run_on_seed(base_dir, self.seed, on_plate)
+    }
+
+    /// [`UserStudyConfig::run`] under master seed `seed` instead of the
+    /// config's: the result is the one a copy of the config with `seed =
+    /// seed` gives.
+    pub fn run_on_seed(
+        &self,
+        base_dir: &Path,
+        seed: u64,
         mut on_plate: impl FnMut(&PlateResult),
     ) -> Result<UserStudyResult> {
-        let mut env = self.build_environment(base_dir)?;
-        let mut study = self.prepare(base_dir, env.as_ref())?;
+        let mut env = self.environment.build(&BuildContext::new(base_dir, seed))?;
+        let mut study = self.prepare_on_seed(base_dir, env.as_ref(), seed)?;
         study.run_with(
             env.as_mut(),
             |_, env, episode| episode(env, &mut []),
@@ -350,7 +377,7 @@ impl UserStudy<'_> {
                 label: self.config.methods[method].label.clone(),
                 repetition: rep + 1,
                 position: position + 1,
-                seed: splitmix(self.config.seed, (rep * n + position) as u64),
+                seed: splitmix(self.seed, (rep * n + position) as u64),
             })
             .collect()
     }
@@ -435,7 +462,7 @@ impl UserStudy<'_> {
                 n_att: cfg.session.n_att,
                 wl0: cfg.session.wl0,
                 repetitions: cfg.repetitions,
-                seed: cfg.seed,
+                seed: self.seed,
             },
             plates,
             methods,
@@ -473,7 +500,7 @@ impl UserStudy<'_> {
                         label: format!("{} (validation, {parameter} = {value})", method.label),
                         repetition: 0,
                         position: i + 1,
-                        seed: splitmix(cfg.seed ^ VALIDATION_STREAM, i as u64),
+                        seed: splitmix(self.seed ^ VALIDATION_STREAM, i as u64),
                     };
                     let (report, _) = run_plate(
                         cfg,

@@ -1,12 +1,18 @@
-//! The user study over many seeds: each method's figures as mean ±
-//! standard error over seeds, beside the paper's real-robot study.
+//! The user study over many seeds: the whole study (pretraining,
+//! validation, plates) once per master seed, in parallel on the one job
+//! runner, and each method's figures as mean ± standard error over seeds,
+//! beside the paper's real-robot study.
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
+use hil_core::{HilError, Result};
+use hil_jobs::Runner;
 use hil_stats::Stat;
 use serde::Serialize;
 
-use super::run::{MethodSummary, UserStudyResult};
+use super::config::UserStudyConfig;
+use super::run::{MethodSummary, Protocol, Selection, UserStudyResult};
 
 /// The paper's real-robot user study, per method: (label, r_task_avg,
 /// n_success per plate, n_q per plate), means (the paper's user-study
@@ -96,5 +102,102 @@ fn of_method(runs: &[UserStudyResult], label: &str) -> MethodAcrossSeeds {
             .iter()
             .find(|p| p.0 == label)
             .map(|p| [p.1, p.2, p.3]),
+    }
+}
+
+/// The study run once per master seed, aggregated over the seeds.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct UserStudyOverSeeds {
+    /// The master seeds, in order.
+    pub seeds: Vec<u64>,
+    /// Every method over the seeds ([`across_seeds`]).
+    pub methods: Vec<MethodAcrossSeeds>,
+    /// Every seed's selections of tuned hyperparameters, in seed order.
+    pub selections: Vec<Vec<Selection>>,
+    /// The first seed's protocol.
+    pub protocol: Protocol,
+}
+
+/// The value a tuned method's validation chose on each seed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ChosenAcrossSeeds {
+    /// The method's label.
+    pub method: String,
+    /// The tuned hyperparameter.
+    pub parameter: String,
+    /// The value chosen on each seed, in seed order.
+    pub values: Vec<f64>,
+    /// Their mean ± standard error.
+    #[serde(with = "hil_stats::summary::as_mean_sem")]
+    pub mean: Stat,
+}
+
+impl UserStudyOverSeeds {
+    /// Aggregates one result per seed (in the order of `seeds`).
+    pub fn of(seeds: Vec<u64>, runs: &[UserStudyResult]) -> Result<Self> {
+        let first = runs
+            .first()
+            .ok_or_else(|| HilError::invalid_parameter("seeds", "[]", "needs at least one seed"))?;
+        Ok(Self {
+            seeds,
+            methods: across_seeds(runs),
+            selections: runs.iter().map(|r| r.selections.clone()).collect(),
+            protocol: first.protocol.clone(),
+        })
+    }
+
+    /// Per tuned method (in order of first appearance), the values its
+    /// validation chose over the seeds.
+    pub fn chosen(&self) -> Vec<ChosenAcrossSeeds> {
+        let mut out: Vec<ChosenAcrossSeeds> = Vec::new();
+        for sel in self.selections.iter().flatten() {
+            match out.iter_mut().find(|c| c.method == sel.method) {
+                Some(c) => c.values.push(sel.chosen),
+                None => out.push(ChosenAcrossSeeds {
+                    method: sel.method.clone(),
+                    parameter: sel.parameter.clone(),
+                    values: vec![sel.chosen],
+                    mean: Stat::of(&[]),
+                }),
+            }
+        }
+        for c in &mut out {
+            c.mean = Stat::of(&c.values);
+        }
+        out
+    }
+}
+
+impl UserStudyConfig {
+    /// Runs the whole study once per master seed in `seeds`, in parallel on
+    /// `runner` (each seed's result is the one [`UserStudyConfig::run`] gives
+    /// with that seed, whatever the thread count), calling `on_seed` as each
+    /// seed finishes; the first failing seed's error is returned.
+    ///
+    /// ```
+    /// use hil_experiments::user_study::UserStudyConfig;
+    /// let cfg = UserStudyConfig::parse(
+    ///     "repetitions = 1\n[environment]\ntype = \"food_replay\"\nfoods = [\"banana\"]\nitems_per_episode = 2\n[[methods]]\nlabel = \"AQ\"\npolicy = { type = \"always_query\", alpha = 0.5 }\n",
+    ///     "study.toml".as_ref(),
+    /// )
+    /// .unwrap();
+    /// let runner = hil_jobs::Runner::new(2).unwrap();
+    /// let over = cfg.run_over_seeds(".".as_ref(), &[3, 4], &runner, &|_| {}).unwrap();
+    /// assert_eq!(over.seeds, [3, 4]);
+    /// assert_eq!(over.methods[0].n_q_per_plate.mean, 2.0); // asks at every item
+    /// ```
+    pub fn run_over_seeds(
+        &self,
+        base_dir: &Path,
+        seeds: &[u64],
+        runner: &Runner,
+        on_seed: &(dyn Fn(u64) + Sync),
+    ) -> Result<UserStudyOverSeeds> {
+        let runs = runner.map(seeds, |&seed| {
+            let run = self.run_on_seed(base_dir, seed, |_| {});
+            on_seed(seed);
+            run
+        })?;
+        UserStudyOverSeeds::of(seeds.to_vec(), &runs)
     }
 }

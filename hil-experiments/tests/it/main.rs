@@ -8,11 +8,8 @@ mod record_fuzz;
 mod run_flow;
 mod session_checks;
 mod testbed;
-#[cfg(feature = "physics")]
 mod user_study;
-#[cfg(feature = "physics")]
+mod user_study_over_seeds;
 mod user_study_plugins;
-#[cfg(feature = "physics")]
 mod user_study_selection;
-#[cfg(feature = "physics")]
 mod user_study_where_asked;

@@ -203,7 +203,7 @@ fn a_workload_model_of_a_registered_type_joins_the_protocol() {
 
 #[test]
 fn a_raised_cancel_flag_stops_the_run() {
-    let (p, _) = small();
+    let (mut p, _) = small();
     let total = p.jobs().unwrap().len();
     let cancel = AtomicBool::new(true);
     match p.run_until_cancelled(&|_, _| {}, &cancel).unwrap() {
@@ -212,20 +212,16 @@ fn a_raised_cancel_flag_stops_the_run() {
     }
     // Raised after three jobs (as a Ctrl-C handler would, mid-run).
     let cancel = AtomicBool::new(false);
-    let outcome = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap()
-        .install(|| {
-            p.run_until_cancelled(
-                &|done, _| {
-                    if done >= 3 {
-                        cancel.store(true, Ordering::Relaxed);
-                    }
-                },
-                &cancel,
-            )
-        })
+    p.runner = hil_jobs::Runner::new(2).unwrap();
+    let outcome = p
+        .run_until_cancelled(
+            &|done, _| {
+                if done >= 3 {
+                    cancel.store(true, Ordering::Relaxed);
+                }
+            },
+            &cancel,
+        )
         .unwrap();
     match outcome {
         // At most one more job per worker thread after the flag.

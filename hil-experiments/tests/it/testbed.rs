@@ -52,19 +52,16 @@ pub fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
     (ds, settings, models)
 }
 
-fn run_all(p: &Protocol, threads: usize) -> Vec<RunRecord> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap()
-        .install(|| p.run_all(&|_, _| {}))
-        .unwrap()
+/// `p`'s records on a runner of `threads` workers.
+fn run_all(p: &mut Protocol, threads: usize) -> Vec<RunRecord> {
+    p.runner = hil_jobs::Runner::new(threads).unwrap();
+    p.run_all(&|_, _| {}).unwrap()
 }
 
 #[test]
 fn protocol_runs_selects_on_validation_and_is_deterministic() {
     let (ds, settings, models) = setup();
-    let p = Protocol::new(settings.clone(), ds.clone(), models.clone()).unwrap();
+    let mut p = Protocol::new(settings.clone(), ds.clone(), models.clone()).unwrap();
     // What each method needs comes from its config: 2 phases × 3 seeds ×
     // (LinUCB + AQ + 2 c × 3 policy seeds + 3 w × 2 deciding models).
     assert_eq!(p.jobs().unwrap().len(), 2 * 3 * (1 + 1 + 6 + 6));
@@ -77,8 +74,8 @@ fn protocol_runs_selects_on_validation_and_is_deterministic() {
     assert_eq!(seen.into_inner(), recs.len());
     let json = |r: &[RunRecord]| serde_json::to_string(r).unwrap();
     assert_eq!(
-        json(&run_all(&p, 1)),
-        json(&run_all(&p, 2)),
+        json(&run_all(&mut p, 1)),
+        json(&run_all(&mut p, 2)),
         "thread count changed results"
     );
 
@@ -245,13 +242,13 @@ fn the_many_seed_run_contains_the_paper_protocol_run() {
     settings.cross.clear();
     settings.figures.rollout = "LinUCB".into();
     settings.figures.workload = vec!["AlwaysQuery".into()];
-    let alone = Protocol::new(settings.clone(), ds.clone(), models.clone()).unwrap();
-    let alone = Reproduction::of(&settings, &models, &run_all(&alone, 2), "t").unwrap();
+    let mut alone = Protocol::new(settings.clone(), ds.clone(), models.clone()).unwrap();
+    let alone = Reproduction::of(&settings, &models, &run_all(&mut alone, 2), "t").unwrap();
     assert!(alone.many_seeds.is_none());
     settings.many_seeds = 6;
-    let p = Protocol::new(settings.clone(), ds, models.clone()).unwrap();
+    let mut p = Protocol::new(settings.clone(), ds, models.clone()).unwrap();
     assert_eq!(p.jobs().unwrap().len(), 2 * 6 * 2);
-    let both = Reproduction::of(&settings, &models, &run_all(&p, 2), "t").unwrap();
+    let both = Reproduction::of(&settings, &models, &run_all(&mut p, 2), "t").unwrap();
     let many = both.many_seeds.as_ref().unwrap();
     assert_eq!((many.n_env_seeds, many.spread), (6, Spread::Se));
     assert_eq!(both.paper_protocol.n_env_seeds, 3);

@@ -33,11 +33,43 @@ fn shipped_file_is_the_paper_protocol() {
 }
 
 #[test]
+#[cfg(feature = "physics")]
 fn an_empty_file_is_the_paper_protocol() {
     assert_eq!(
         as_toml(&parse("").unwrap()),
         as_toml(&UserStudyConfig::paper())
     );
+}
+
+/// A build without MuJoCo cannot run the default scene, so it refuses a
+/// file that leaves the environment out, naming the file and the table.
+#[test]
+#[cfg(not(feature = "physics"))]
+fn without_physics_a_file_must_name_its_environment() {
+    let err = parse("repetitions = 1\n").unwrap_err();
+    assert_eq!(err.field.as_deref(), Some("environment"), "{err}");
+    let shown = err.to_string();
+    assert!(shown.contains("study.toml"), "{shown}");
+    assert!(shown.contains("--features physics"), "{shown}");
+    // Other errors of the file come first, at their own keys.
+    let err = parse("repetitions = 0\n").unwrap_err();
+    assert_eq!(err.field.as_deref(), Some("repetitions"), "{err}");
+    // Naming one is enough.
+    assert!(parse(&format!("repetitions = 1\n{CHEAP_ENV}")).is_ok());
+}
+
+/// The paper's protocol runs on any environment, without physics.
+#[test]
+fn the_paper_protocol_runs_on_another_environment() {
+    let env = parse(CHEAP_ENV).unwrap().environment;
+    let mut cfg = UserStudyConfig::paper_on(env);
+    cfg.repetitions = 1;
+    let paper = UserStudyConfig::paper();
+    assert_eq!(cfg.labels(), paper.labels());
+    assert_eq!(cfg.validation, paper.validation);
+    let result = cfg.run(Path::new("."), |_| {}).unwrap();
+    assert_eq!(result.protocol.environment, "food_replay");
+    assert_eq!(result.plates.len(), 3);
 }
 
 #[test]
@@ -49,13 +81,16 @@ fn written_out_config_reads_back_the_same() {
 
 #[test]
 fn session_merges_over_the_papers() {
-    let cfg = parse("[session]\nwl0 = 0.25\n").unwrap();
+    let cfg = parse(&format!("[session]\nwl0 = 0.25\n{CHEAP_ENV}")).unwrap();
     assert_eq!((cfg.session.n_att, cfg.session.wl0), (3, 0.25));
 }
 
 #[test]
 fn a_channel_table_replaces_the_default_channel() {
-    let cfg = parse("[channel]\ntype = \"simulated_expert\"\nerror_rate = 0.2\n").unwrap();
+    let cfg = parse(&format!(
+        "[channel]\ntype = \"simulated_expert\"\nerror_rate = 0.2\n{CHEAP_ENV}"
+    ))
+    .unwrap();
     let channel = &as_toml(&cfg)["channel"];
     assert_eq!(channel["error_rate"].as_float(), Some(0.2));
 }

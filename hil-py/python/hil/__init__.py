@@ -45,6 +45,7 @@ from ._hil import (
     run,
     run_session,
     select_workload,
+    user_study,
 )
 
 import importlib.util as _ilu
@@ -93,6 +94,7 @@ __all__ = [
     "run_session",
     "select_workload",
     "testing",
+    "user_study",
 ]
 
 

@@ -301,6 +301,17 @@ def reproduce(
     progress: Union[None, bool, Callable[[int, int], Any]] = None,
 ) -> Dict[str, Any]: ...
 
+def user_study(
+    study: Union[None, _Path, Mapping[str, Any]] = None,
+    *,
+    environment: Optional[Mapping[str, Any]] = None,
+    seed: Optional[int] = None,
+    repetitions: Optional[int] = None,
+    n_att: Optional[int] = None,
+    seeds: Optional[int] = None,
+    threads: int = 0,
+) -> Dict[str, Any]: ...
+
 # --- conformance suites (hil.testing) --------------------------------------------
 
 class _Testing(ModuleType):

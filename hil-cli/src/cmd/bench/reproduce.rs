@@ -15,20 +15,21 @@ pub struct ReproduceBench {
     /// Timed runs (the first is also timed: nothing is cached across runs).
     #[arg(long, default_value_t = 3)]
     runs: usize,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: crate::cmd::Threads,
 }
 
 pub fn bench_reproduce(a: &ReproduceBench) -> Result<()> {
     hil_config::limits::check_count("--runs", a.runs, 100)?;
-    let (pool, threads) = crate::cmd::worker_pool(a.threads)?;
+    let runner = a.threads.runner()?;
+    let threads = runner.threads();
     let mut wall = Vec::with_capacity(a.runs);
     let mut episodes = 0;
     for _ in 0..a.runs {
         let t0 = Instant::now();
-        let protocol = Protocol::from_settings(ProtocolSettings::paper())?;
-        let records = pool.install(|| protocol.run_all(&|_, _| {}))?;
+        let protocol =
+            Protocol::from_settings(ProtocolSettings::paper())?.with_runner(runner.clone());
+        let records = protocol.run_all(&|_, _| {})?;
         protocol.reproduction(&records)?;
         wall.push(t0.elapsed().as_secs_f64());
         episodes = records.len();

@@ -1,0 +1,106 @@
+//! The user study over many seeds, as a library: each seed's run is the
+//! one a single run with that seed gives, whatever the thread count, and
+//! the figures over seeds are the mean ± standard error of each seed's.
+
+use std::path::Path;
+
+use hil_experiments::user_study::{UserStudyConfig, UserStudyOverSeeds};
+use hil_jobs::Runner;
+use hil_stats::Stat;
+
+/// Two methods, one tuned, on the bundled synthetic food dataset.
+fn study() -> UserStudyConfig {
+    UserStudyConfig::parse(
+        r#"
+        repetitions = 1
+        [environment]
+        type = "food_replay"
+        foods = ["banana", "carrot"]
+        pretrain_foods = ["apple", "kiwi", "strawberry"]
+        items_per_episode = 3
+        [validation]
+        plates = 2
+        [[methods]]
+        label = "LinUCB"
+        policy = { type = "linucb", alpha = 0.5, lambda = 1.0, pretrain = true }
+        [[methods]]
+        label = "LinUCB-QG"
+        policy = { type = "linucb_qg", alpha = 0.5, lambda = 1.0, w = 1.0, pretrain = true }
+        tune = { w = [0.5, 8.0] }
+        "#,
+        Path::new("study.toml"),
+    )
+    .unwrap()
+}
+
+#[test]
+fn every_seed_is_its_own_single_run_at_any_thread_count() {
+    let cfg = study();
+    let seeds = [11, 12, 13];
+    let base = Path::new(".");
+    let singles: Vec<_> = seeds
+        .iter()
+        .map(|&s| cfg.run_on_seed(base, s, |_| {}).unwrap())
+        .collect();
+    // `run_on_seed` is `run` on a config with that seed.
+    let mut at_12 = study();
+    at_12.seed = 12;
+    assert_eq!(at_12.run(base, |_| {}).unwrap(), singles[1]);
+
+    let finished = std::sync::Mutex::new(Vec::new());
+    let over = cfg
+        .run_over_seeds(base, &seeds, &Runner::new(2).unwrap(), &|s| {
+            finished.lock().unwrap().push(s)
+        })
+        .unwrap();
+    assert_eq!(
+        over,
+        UserStudyOverSeeds::of(seeds.to_vec(), &singles).unwrap()
+    );
+    let mut finished = finished.into_inner().unwrap();
+    finished.sort();
+    assert_eq!(finished, seeds);
+    let serial = cfg
+        .run_over_seeds(base, &seeds, &Runner::new(1).unwrap(), &|_| {})
+        .unwrap();
+    assert_eq!(serial, over);
+
+    assert_eq!(over.seeds, seeds);
+    assert_eq!(over.protocol.seed, 11);
+    assert_eq!(over.selections.len(), 3);
+    // Each figure is the mean ± SE over seeds of each seed's mean per plate.
+    let r: Vec<f64> = singles.iter().map(|s| s.methods[1].r_task_avg).collect();
+    assert_eq!(over.methods[1].method, "LinUCB-QG");
+    assert_eq!(over.methods[1].r_task_avg, Stat::of(&r));
+    // The tuned method's choice per seed, in seed order.
+    let chosen = over.chosen();
+    assert_eq!(chosen.len(), 1);
+    assert_eq!(
+        (chosen[0].method.as_str(), chosen[0].parameter.as_str()),
+        ("LinUCB-QG", "w")
+    );
+    let per_seed: Vec<f64> = singles.iter().map(|s| s.selections[0].chosen).collect();
+    assert_eq!(chosen[0].values, per_seed);
+    assert_eq!(chosen[0].mean, Stat::of(&per_seed));
+}
+
+#[test]
+fn a_failing_seed_fails_the_run_and_no_seeds_is_an_error() {
+    let mut cfg = study();
+    // A dataset directory that does not exist: every seed's build fails.
+    cfg.environment = UserStudyConfig::parse(
+        "[environment]\ntype = \"food_replay\"\ndataset = \"no/such/dir\"\nfoods = [\"banana\"]\n",
+        Path::new("bad.toml"),
+    )
+    .unwrap()
+    .environment;
+    let runner = Runner::new(2).unwrap();
+    let err = cfg
+        .run_over_seeds(Path::new("."), &[1, 2], &runner, &|_| {})
+        .unwrap_err();
+    assert!(err.to_string().contains("no/such/dir"), "{err}");
+    let err = study()
+        .run_over_seeds(Path::new("."), &[], &runner, &|_| {})
+        .unwrap_err();
+    assert!(err.to_string().contains("seed"), "{err}");
+}

@@ -11,9 +11,9 @@
 //! - [`WebChannel`]: a page served on 127.0.0.1 for the person being fed,
 //!   on a phone or tablet, by touch, keyboard or single switch
 //!   (`type = "web"`).
-//! - [`study`]: the paper's querying-workload study served on the same
-//!   server (`hil study serve`), with fsync'ed, resumable participant logs
-//!   and an export to the study CSV that `hil_workload` fits models from.
+//!
+//! The web page is served by `hil-http`, the small server the browser
+//! workload study (`hil-study`, `hil study serve`) uses too.
 //!
 //! To try the channels without a robot, the demo components live with
 //! their traits: `hil_envs::demo_plate` (`demo_plate`),
@@ -25,17 +25,8 @@
 
 pub mod present;
 pub mod simulated;
-pub mod study;
 pub mod terminal;
 pub mod web;
-
-// The HTTP server's unit tests (web::http) use the integration tests'
-// helpers, which name this crate by its name.
-#[cfg(test)]
-extern crate self as hil_channels;
-#[cfg(test)]
-#[path = "../tests/it/web_support/mod.rs"]
-mod web_support;
 
 pub use simulated::{ResponseTimeModel, SimulatedExpert, SimulatedExpertConfig};
 pub use terminal::{TerminalChannel, TerminalChannelConfig};

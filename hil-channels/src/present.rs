@@ -106,6 +106,20 @@ pub fn action_named_in(text: &str, actions: &ActionSpace) -> Option<ArmId> {
 /// Checks that `answer` fits `query` (its response type, its action space)
 /// and returns the action it implies: the chosen arm for an MCQ, the action
 /// a text names, none for a box or a decline.
+///
+/// ```
+/// use hil_core::{Answer, ArmId, Context, Item, Query, QueryKind, ResponseType};
+/// let q = Query::new(
+///     1,
+///     Item::new(0, "grape"),
+///     QueryKind { response: ResponseType::OpenEnded, ..Default::default() },
+///     hil_envs::feeding::action_space(),
+///     Context::new(vec![0.0]).unwrap(),
+/// );
+/// let e = hil_channels::present::validate_answer(&q, &Answer::Action { arm: ArmId(2) });
+/// let why = e.unwrap_err().to_string();
+/// assert!(why.contains(r#"cannot be answered with {"type":"action","arm":2}"#), "{why}");
+/// ```
 pub fn validate_answer(query: &Query, answer: &Answer) -> Result<Option<ArmId>> {
     let invalid = |why: String| HilError::invalid_input("answer", why);
     match (query.kind.response, answer) {
@@ -125,13 +139,17 @@ pub fn validate_answer(query: &Query, answer: &Answer) -> Result<Option<ArmId>> 
             check_text(text).map_err(invalid)?;
             Ok(action_named_in(text, &query.actions))
         }
-        (expected, got) => Err(invalid(format!(
-            "a {} query cannot be answered with {got:?}",
-            match expected {
+        // The answer as it is sent (JSON), not as Rust prints it.
+        (expected, got) => {
+            let expected = match expected {
                 ResponseType::Mcq => "multiple-choice",
                 ResponseType::BoundingBox => "bounding-box",
                 ResponseType::OpenEnded => "open-ended",
-            }
-        ))),
+            };
+            let got = serde_json::to_string(got).unwrap_or_else(|_| "this answer".into());
+            Err(invalid(format!(
+                "a {expected} query cannot be answered with {got}"
+            )))
+        }
     }
 }

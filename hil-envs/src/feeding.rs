@@ -279,6 +279,22 @@ impl FeedingTask {
         self.actions.names()
     }
 
+    /// What the action named `name` does, if it is one of the task's
+    /// (`feeding_actions.csv`); the web page shows it under the action's
+    /// name.
+    ///
+    /// ```
+    /// let task = hil_envs::feeding::FeedingTask::bundled();
+    /// assert!(task.action_description("VS0").unwrap().starts_with("vertical skewer"));
+    /// assert_eq!(task.action_description("left"), None);
+    /// ```
+    pub fn action_description(&self, name: &str) -> Option<&str> {
+        let arm = self.actions.find(name)?;
+        self.action_descriptions
+            .get(arm.index())
+            .map(String::as_str)
+    }
+
     /// The food named `name`, if the task has it.
     pub fn food(&self, name: &str) -> Option<&FoodFacts> {
         self.foods.iter().find(|f| f.name == name)

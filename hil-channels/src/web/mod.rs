@@ -1,28 +1,31 @@
 //! A query channel served as a web page, for the person being fed: on a
 //! phone or tablet next to the robot, by touch, keyboard or single switch.
 
-use hil_config::TaskContext;
-pub(crate) mod http;
-pub mod urls;
-
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
-use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::sync::{Arc, Condvar, LazyLock, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use rand::Rng;
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
-use hil_config::QueryChannelConfig;
+use hil_config::{QueryChannelConfig, TaskContext};
 use hil_core::{Answer, ArmId, HilError, Query, QueryChannel, Response, Result};
+use hil_envs::feeding::FeedingTask;
+use hil_http::guard::{
+    Site, check_allowed_hosts, forbidden, random_token, refuse_foreign_post, same_token,
+    split_token,
+};
+use hil_http::page::{
+    CSS, HTML, JS, PAGE_CSS, Picture, SCAN_JS, asset, find_picture, with_scan_settings,
+};
+use hil_http::{Limits, Occupancy, Request, Response as HttpResponse, Server, Service, urls};
 
 use crate::present::{describe_item, describe_kind, question, validate_answer};
-use http::{Limits, Occupancy, Request, Response as HttpResponse, Server, Service};
 
-const PAGE_HTML: &str = include_str!("page.html");
+/// The page, with the shared switch-scanning settings in its header.
+static PAGE_HTML: LazyLock<String> =
+    LazyLock::new(|| with_scan_settings(include_str!("page.html")));
 const PAGE_JS: &str = include_str!("page.js");
-/// The page's style sheet; the study's pages share it.
-pub(crate) const PAGE_CSS: &str = include_str!("page.css");
 
 /// The default time a person has to answer before the policy acts alone.
 pub const DEFAULT_TIMEOUT_S: f64 = 120.0;
@@ -103,8 +106,8 @@ struct Pending {
     asked_at: Instant,
     deadline: Instant,
     answer: Option<(Answer, Option<ArmId>)>,
-    /// The item's picture and its content type, if there is one.
-    image: Option<(Vec<u8>, &'static str)>,
+    /// The item's picture, if there is one.
+    image: Option<Picture>,
 }
 
 #[derive(Default)]
@@ -117,9 +120,8 @@ struct State {
 
 struct Shared {
     token: String,
-    /// The bound port, set once the server is listening.
-    port: std::sync::OnceLock<u16>,
-    allowed_hosts: Vec<String>,
+    /// The names and (once listening) the port the page answers to.
+    site: Site,
     timeout: Duration,
     images: Option<std::path::PathBuf>,
     state: Mutex<State>,
@@ -143,7 +145,7 @@ impl Shared {
 /// - Clients without the token cannot lock the person out: each request
 ///   must arrive whole within 10 s, and requests carrying the token have
 ///   connection slots of their own (the server's limits are listed in
-///   `hil-channels/src/web/http/mod.rs`).
+///   the `hil_http` crate's documentation).
 /// - Answers are accepted only from the page's own origin (`Origin` must
 ///   match `Host`, a JSON body is required, `Host` must be an IP address,
 ///   `localhost` or an allowed name), so another web site open in the same
@@ -177,25 +179,6 @@ impl std::fmt::Debug for WebChannel {
     }
 }
 
-/// Every extra name a page may be reached by (`allowed_hosts`, of the query
-/// page and of the study) must be a plain host name.
-pub(crate) fn check_allowed_hosts(hosts: &[String]) -> Result<()> {
-    for h in hosts {
-        if h.is_empty()
-            || !h
-                .bytes()
-                .all(|b| b.is_ascii_alphanumeric() || b == b'.' || b == b'-')
-        {
-            return Err(HilError::invalid_parameter(
-                "allowed_hosts",
-                h,
-                "must be a host name (letters, digits, dots, dashes)",
-            ));
-        }
-    }
-    Ok(())
-}
-
 impl WebChannel {
     /// Validates `config`, binds the server and starts serving.
     pub fn start(config: WebChannelConfig) -> Result<Self> {
@@ -210,22 +193,13 @@ impl WebChannel {
                 "is not a directory",
             ));
         }
-        let token: String = rand::rng()
-            .random::<[u8; 16]>()
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
+        let token = random_token();
         let bind = SocketAddr::new(config.bind, config.port);
         // The handler needs the bound port, known only after binding: it
         // reads it from `Shared`, filled in right after.
         let shared = Arc::new(Shared {
             token,
-            port: std::sync::OnceLock::new(),
-            allowed_hosts: config
-                .allowed_hosts
-                .iter()
-                .map(|h| h.to_ascii_lowercase())
-                .collect(),
+            site: Site::new(&config.allowed_hosts),
             timeout: Duration::from_secs_f64(config.timeout_s),
             images: config.images.clone(),
             state: Mutex::new(State::default()),
@@ -235,20 +209,9 @@ impl WebChannel {
         let server = Server::start(bind, Arc::new(Page(shared.clone())), Limits::default())
             .map_err(|e| channel_error(format!("cannot listen on {bind}: {e}")))?;
         let addr = server.addr();
-        let _ = shared.port.set(addr.port());
-        let hosts = urls::reachable_hosts(addr.ip()).map_err(|e| {
-            channel_error(format!(
-                "listening on {addr}, but cannot list this machine's addresses to print \
-                 the page's URL ({e}); set `bind` to the address to use"
-            ))
-        })?;
-        if hosts.is_empty() {
-            return Err(channel_error(format!(
-                "listening on {addr}, but this machine has no address of that kind to open \
-                 the page at; set `bind` to the address to use"
-            )));
-        }
-        let urls = hosts
+        shared.site.set_port(addr.port());
+        let urls = urls::hosts_to_print(addr)
+            .map_err(channel_error)?
             .into_iter()
             .map(|ip| urls::page_url(ip, addr.port(), &shared.token))
             .collect();
@@ -296,7 +259,7 @@ impl QueryChannel for WebChannel {
 
     fn ask(&mut self, query: &Query) -> Result<Response> {
         let image = match &self.shared.images {
-            Some(dir) => load_image(dir, &query.item.label)?,
+            Some(dir) => find_picture(dir, &query.item.label)?,
             None => None,
         };
         let mut state = self.shared.lock();
@@ -348,50 +311,10 @@ impl QueryChannel for WebChannel {
     }
 }
 
-/// The picture of item `label` in `dir`, if there is one. Labels that are
-/// not plain names (letters, digits, `_`, `-`) never map to a file. SVG is
-/// not served: it can carry scripts. A picture that is not a regular file
-/// or is larger than `hil_core::files::limits::ASSET` is an error (naming
-/// the file), not a question without its picture.
-fn load_image(dir: &std::path::Path, label: &str) -> Result<Option<(Vec<u8>, &'static str)>> {
-    if label.is_empty()
-        || !label
-            .bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
-    {
-        return Ok(None);
-    }
-    for (ext, content_type) in [
-        ("png", "image/png"),
-        ("jpg", "image/jpeg"),
-        ("jpeg", "image/jpeg"),
-        ("webp", "image/webp"),
-    ] {
-        let path = dir.join(format!("{label}.{ext}"));
-        if !path.exists() {
-            continue;
-        }
-        let bytes = hil_core::files::read_bytes(&path, hil_core::files::limits::ASSET)?;
-        return Ok(Some((bytes, content_type)));
-    }
-    Ok(None)
-}
-
-/// Short explanations of the feeding actions, shown under their names.
-fn action_hint(name: &str) -> Option<String> {
-    let (pitch, roll) = name.split_at(name.len().min(2));
-    let pitch = match pitch {
-        "VS" => "fork straight down",
-        "TV" => "fork tilted, coming down vertically",
-        "TA" => "fork tilted, coming in at an angle",
-        _ => return None,
-    };
-    let roll = match roll {
-        "0" => "tines along the food",
-        "90" => "tines across the food",
-        _ => return None,
-    };
-    Some(format!("{pitch}; {roll}"))
+/// What a feeding action does, shown under its name; other tasks' actions
+/// have no hint.
+fn action_hint(name: &str) -> Option<&'static str> {
+    FeedingTask::bundled().action_description(name)
 }
 
 fn query_view(p: &Pending) -> Value {
@@ -418,45 +341,6 @@ fn query_view(p: &Pending) -> Value {
     })
 }
 
-pub(crate) fn forbidden(why: &str) -> HttpResponse {
-    HttpResponse::text(403, format!("forbidden: {why}"))
-}
-
-/// Compares without revealing, by timing, how much of the token matched.
-pub(crate) fn same_token(a: &str, b: &str) -> bool {
-    a.len() == b.len()
-        && a.bytes()
-            .zip(b.bytes())
-            .fold(0u8, |acc, (x, y)| acc | (x ^ y))
-            == 0
-}
-
-/// Whether the `Host` header names this server: an IP address, `localhost`
-/// or an allowed name, on our port. Refusing other names defeats DNS
-/// rebinding.
-fn host_allowed(shared: &Shared, port: u16, host: &str) -> bool {
-    host_allowed_in(&shared.allowed_hosts, port, host)
-}
-
-/// [`host_allowed`] for a list of allowed (lower-case) names.
-pub(crate) fn host_allowed_in(allowed_hosts: &[String], port: u16, host: &str) -> bool {
-    let host = host.to_ascii_lowercase();
-    let (name, host_port) = match host.rsplit_once(':') {
-        Some((n, p)) if !n.ends_with(']') || host.starts_with('[') => match p.parse::<u16>() {
-            Ok(p) => (n.to_string(), p),
-            Err(_) => return false,
-        },
-        _ => (host.clone(), 80),
-    };
-    if host_port != port {
-        return false;
-    }
-    let bare = name.trim_start_matches('[').trim_end_matches(']');
-    bare.parse::<IpAddr>().is_ok()
-        || bare == "localhost"
-        || allowed_hosts.iter().any(|h| *h == bare)
-}
-
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct AnswerRequest {
@@ -477,12 +361,6 @@ impl Service for Page {
     }
 }
 
-/// Splits `/TOKEN/rest` into the token and the rest.
-pub(crate) fn split_token(path: &str) -> (&str, &str) {
-    let mut segments = path.trim_start_matches('/').splitn(2, '/');
-    (segments.next().unwrap_or(""), segments.next().unwrap_or(""))
-}
-
 fn handle(shared: &Shared, req: &Request) -> HttpResponse {
     let (token, rest) = split_token(&req.path);
     if token.is_empty() {
@@ -491,22 +369,14 @@ fn handle(shared: &Shared, req: &Request) -> HttpResponse {
     if !same_token(token, &shared.token) {
         return forbidden("wrong session token");
     }
-    let Some(&port) = shared.port.get() else {
-        return HttpResponse::text(503, "starting");
-    };
-    match req.header("host") {
-        Some(h) if host_allowed(shared, port, h) => {}
-        _ => return forbidden("unexpected Host"),
+    if let Err(refused) = shared.site.check_host(req) {
+        return refused;
     }
-    let asset = |body: &str, content_type: &'static str| HttpResponse {
-        status: 200,
-        content_type,
-        body: body.as_bytes().to_vec(),
-    };
     match (req.method.as_str(), rest) {
-        ("GET", "") => asset(PAGE_HTML, "text/html; charset=utf-8"),
-        ("GET", "app.js") => asset(PAGE_JS, "text/javascript; charset=utf-8"),
-        ("GET", "app.css") => asset(PAGE_CSS, "text/css; charset=utf-8"),
+        ("GET", "") => asset(PAGE_HTML.as_str(), HTML),
+        ("GET", "app.js") => asset(PAGE_JS, JS),
+        ("GET", "scan.js") => asset(SCAN_JS, JS),
+        ("GET", "app.css") => asset(PAGE_CSS, CSS),
         ("GET", "api/query") => {
             let state = shared.lock();
             match &state.current {
@@ -518,59 +388,19 @@ fn handle(shared: &Shared, req: &Request) -> HttpResponse {
         ("GET", r) if r.starts_with("image/") => {
             let state = shared.lock();
             match &state.current {
-                Some(p) if r == format!("image/{}", p.id) && p.image.is_some() => {
-                    let (bytes, content_type) = p.image.as_ref().expect("checked");
-                    HttpResponse {
-                        status: 200,
-                        content_type,
-                        body: bytes.clone(),
-                    }
-                }
+                Some(Pending {
+                    id,
+                    image: Some(picture),
+                    ..
+                }) if r == format!("image/{id}") => picture.response(),
                 _ => HttpResponse::text(404, "no picture"),
             }
         }
-        (_, "" | "app.js" | "app.css" | "api/query" | "api/answer") => {
+        (_, "" | "app.js" | "scan.js" | "app.css" | "api/query" | "api/answer") => {
             HttpResponse::text(405, "method not allowed")
         }
         _ => HttpResponse::text(404, "not found"),
     }
-}
-
-/// Refuses a POST that does not come from the page itself: browsers always
-/// send Origin on a POST, and a JSON body cannot be sent cross-origin
-/// without a CORS preflight, which this server never grants.
-pub(crate) fn refuse_foreign_post(req: &Request) -> Option<HttpResponse> {
-    let host = req.header("host").unwrap_or("");
-    match req.header("origin") {
-        Some(o) if o.eq_ignore_ascii_case(&format!("http://{host}")) => {}
-        Some(_) => {
-            return Some(forbidden(
-                "answers are accepted only from the page's own origin",
-            ));
-        }
-        None => return Some(forbidden("answers need an Origin header")),
-    }
-    if let Some(site) = req.header("sec-fetch-site")
-        && site != "same-origin"
-    {
-        return Some(forbidden(
-            "answers are accepted only from the page's own origin",
-        ));
-    }
-    let is_json = req.header("content-type").is_some_and(|c| {
-        c.split(';')
-            .next()
-            .unwrap_or("")
-            .trim()
-            .eq_ignore_ascii_case("application/json")
-    });
-    if !is_json {
-        return Some(HttpResponse::text(
-            415,
-            "the answer must be sent as application/json",
-        ));
-    }
-    None
 }
 
 fn post_answer(shared: &Shared, req: &Request) -> HttpResponse {

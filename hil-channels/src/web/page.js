@@ -8,10 +8,7 @@
   let box = null;         // [x0, y0, x1, y1] in 0..1
   let drag = null;
   let picture = null;     // the item's picture, when the server has one
-  let scanTimer = null;
-  let scanIndex = -1;
   let sending = false;
-  let programmatic = false;  // a click made by the switch, not by a tap
 
   function setStatus(text) {
     if ($("status").textContent !== text) $("status").textContent = text;
@@ -73,13 +70,13 @@
     // Move focus to the first control so keyboard users start at the answer.
     const first = controls()[0];
     if (first) first.focus();
-    restartScan();
+    scan.restart();
   }
 
   function hide() {
     current = null;
     $("query").hidden = true;
-    stopScan();
+    scan.stop();
   }
 
   function buildChoices(q) {
@@ -241,46 +238,14 @@
     });
   }
 
-  // ---- single-switch scanning --------------------------------------------
-  // When on, the highlight moves through the answer controls by itself; one
-  // switch (Space, Enter, or a tap anywhere) activates the highlighted one.
+  // ---- single-switch scanning (scan.js) ----------------------------------
+  // The highlight steps through the open question's answer controls.
   function controls() {
     const sel = "#answer-area fieldset:not([hidden]) button, #answer-area fieldset:not([hidden]) textarea, #decline";
     return Array.from(document.querySelectorAll(sel)).filter((e) => !e.disabled && e.offsetParent !== null);
   }
-  const scanning = () => $("scan-toggle").checked;
-  function stopScan() {
-    if (scanTimer) clearInterval(scanTimer);
-    scanTimer = null;
-    document.querySelectorAll(".scan-focus").forEach((e) => e.classList.remove("scan-focus"));
-  }
-  function restartScan() {
-    stopScan();
-    if (!scanning() || !current) return;
-    scanIndex = -1;
-    const tick = () => {
-      const list = controls();
-      if (!list.length) return;
-      document.querySelectorAll(".scan-focus").forEach((e) => e.classList.remove("scan-focus"));
-      scanIndex = (scanIndex + 1) % list.length;
-      list[scanIndex].classList.add("scan-focus");
-      list[scanIndex].focus();
-    };
-    tick();
-    scanTimer = setInterval(tick, parseInt($("scan-speed").value, 10));
-  }
-  function switchPressed(ev) {
-    if (!scanning() || !current) return;
-    if (ev.target === $("scan-toggle") || ev.target === $("scan-speed")) return;
-    const el = document.querySelector(".scan-focus");
-    if (!el) return;
-    if (el.tagName === "TEXTAREA") { stopScan(); el.focus(); return; }  // typing needs a keyboard
-    ev.preventDefault();
-    programmatic = true;
-    el.click();
-    programmatic = false;
-    restartScan();
-  }
+  const scan = hilScan({ controls: controls, active: () => current !== null });
+  const scanning = scan.scanning;
 
   document.addEventListener("DOMContentLoaded", () => {
     setupBox();
@@ -290,21 +255,6 @@
       if (!text) { $("error").textContent = "Type an answer first, or choose \"I don't know\"."; return; }
       send({ type: "text", text: text });
     });
-    $("scan-toggle").addEventListener("change", restartScan);
-    $("scan-speed").addEventListener("change", restartScan);
-    document.addEventListener("keydown", (ev) => {
-      if (scanning() && (ev.key === " " || ev.key === "Enter")) switchPressed(ev);
-    }, true);
-    document.addEventListener("pointerdown", (ev) => { if (scanning()) switchPressed(ev); }, true);
-    // While scanning, a tap means "select the highlighted control", never
-    // "click what is under the finger".
-    document.addEventListener("click", (ev) => {
-      if (scanning() && !programmatic && ev.target !== $("scan-toggle") && ev.target !== $("scan-speed") &&
-          !(ev.target.closest && ev.target.closest("label.scan-toggle, label.scan-speed"))) {
-        ev.preventDefault();
-        ev.stopPropagation();
-      }
-    }, true);
     syncInputs();
     poll();
   });

@@ -19,8 +19,7 @@ use hil_core::{
 };
 use serde_json::json;
 
-use crate::browser_support;
-use browser_support::{Browser, contrast, tools_present};
+use hil_http::testing::browser::{Browser, contrast, tools_present};
 
 fn query(t: u64, response: ResponseType) -> Query {
     Query::new(
@@ -134,7 +133,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     }
     browser.click("#choice-3");
     let (ch, r) = asking.join().unwrap();
-    browser.wait_until_no_question();
+    wait_until_no_question(&browser);
     assert_eq!(r.answer, Answer::Action { arm: ArmId(3) });
     assert_eq!(r.expert_arm, Some(ArmId(3)));
 
@@ -152,7 +151,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     }
     browser.keys(&["\u{E004}", "\u{E004}", "\u{E007}"]);
     let (ch, r) = asking.join().unwrap();
-    browser.wait_until_no_question();
+    wait_until_no_question(&browser);
     assert_eq!(r.answer, Answer::Action { arm: ArmId(2) });
 
     // 3. Bounding box drawn with a finger on the canvas.
@@ -166,7 +165,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     );
     browser.click("#send-box");
     let (ch, r) = asking.join().unwrap();
-    browser.wait_until_no_question();
+    wait_until_no_question(&browser);
     let Answer::BoundingBox { bbox } = r.answer else {
         panic!("{:?}", r.answer)
     };
@@ -186,7 +185,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.click("#region-8");
     browser.click("#send-box");
     let (ch, r) = asking.join().unwrap();
-    browser.wait_until_no_question();
+    wait_until_no_question(&browser);
     let Answer::BoundingBox { bbox } = r.answer else {
         panic!("{:?}", r.answer)
     };
@@ -203,7 +202,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.keys(&["\u{E014}", "\u{E014}", "\u{E014}"]); // ArrowRight ×3
     browser.click("#send-box");
     let (ch, r) = asking.join().unwrap();
-    browser.wait_until_no_question();
+    wait_until_no_question(&browser);
     let Answer::BoundingBox { bbox } = r.answer else {
         panic!("{:?}", r.answer)
     };
@@ -221,7 +220,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.type_into("#answer-text", "It rolls; try TV90");
     browser.click("#send-text");
     let (ch, r) = asking.join().unwrap();
-    browser.wait_until_no_question();
+    wait_until_no_question(&browser);
     assert_eq!(
         r.answer,
         Answer::Text {
@@ -238,7 +237,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.find("#choice-0.scan-focus");
     browser.keys(&[" "]);
     let (ch, r) = asking.join().unwrap();
-    browser.wait_until_no_question();
+    wait_until_no_question(&browser);
     assert_eq!(r.answer, Answer::Action { arm: ArmId(0) });
 
     // The page says the answer was received and waits for the next one.
@@ -252,4 +251,19 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
         std::thread::sleep(Duration::from_millis(50));
     }
     drop(ch);
+}
+
+/// Waits until the page has taken its last answer down. The channel
+/// returns as soon as the server has the answer, a moment before the page
+/// hears back; a next question's controls must not be confused with the
+/// previous question's, still on screen.
+fn wait_until_no_question(browser: &Browser) {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while browser.script("return document.getElementById('query').hidden;") != json!(true) {
+        assert!(
+            Instant::now() < deadline,
+            "the answered question stayed on screen"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
 }

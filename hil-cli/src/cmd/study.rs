@@ -4,11 +4,11 @@
 use std::net::{IpAddr, Ipv4Addr};
 use std::path::PathBuf;
 
-use hil_channels::study::log::{Event, read};
-use hil_channels::study::server::{participant_logs, stored_design};
-use hil_channels::study::session::tally;
-use hil_channels::study::{Design, StudyConfig, StudyServer, export};
 use hil_core::Result;
+use hil_study::log::{Event, read};
+use hil_study::server::{participant_logs, stored_design};
+use hil_study::session::tally;
+use hil_study::{Design, StudyConfig, StudyServer, export_all};
 use hil_workload::study::Population;
 
 /// Arguments of `hil study`.
@@ -48,12 +48,14 @@ enum StudyCommand {
         #[arg(long)]
         data: PathBuf,
     },
-    /// Write the study CSV that `hil workload summary/select/fit` read.
+    /// Write the study CSV that `hil workload summary/select/fit` read, and
+    /// the end-of-condition surveys of query conditions beside it
+    /// (`<stem>.end_of_condition.csv`).
     Export {
         /// Data folder.
         #[arg(long)]
         data: PathBuf,
-        /// Output CSV.
+        /// Output CSV (the study CSV).
         #[arg(long)]
         out: PathBuf,
     },
@@ -123,7 +125,7 @@ pub fn run(args: StudyArgs) -> Result<()> {
             let design = Design::new(design)?;
             for path in participant_logs(&data)? {
                 let (lines, _) = read(&path)?;
-                let (surveys, done, of) = tally(&design, &path, &lines)?;
+                let t = tally(&design, &path, &lines)?;
                 let Some(Event::Enrolled {
                     participant,
                     population,
@@ -133,20 +135,30 @@ pub fn run(args: StudyArgs) -> Result<()> {
                     continue;
                 };
                 println!(
-                    "{participant} {}: {done}/{of} conditions, {surveys} surveys",
-                    population.as_str()
+                    "{participant} {}: {}/{} conditions, {} surveys ({} in the study CSV, \
+                     {} at the end of a query condition)",
+                    population.as_str(),
+                    t.conditions_done,
+                    t.conditions,
+                    t.surveys,
+                    t.surveys - t.end_of_condition_surveys,
+                    t.end_of_condition_surveys
                 );
             }
             Ok(())
         }
         StudyCommand::Export { data, out } => {
-            let study = export(&data)?;
-            study.write(&out)?;
+            let export = export_all(&data)?;
+            let end = export.write(&out)?;
             println!(
-                "wrote {} surveys to {} (read it with `hil workload summary --data {}`)",
-                study.records().len(),
+                "wrote {} surveys: {} to {} (read it with `hil workload summary --data {}`), \
+                 {} end-of-condition surveys to {}",
+                export.surveys(),
+                export.study.records().len(),
                 out.display(),
-                out.display()
+                out.display(),
+                export.end_of_condition.len(),
+                end.display()
             );
             Ok(())
         }

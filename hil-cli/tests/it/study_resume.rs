@@ -271,6 +271,17 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // Every survey is exported, as many as status counts: c01's
+    // end-of-condition survey goes to the second CSV.
+    let said = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(said.starts_with("wrote 7 surveys: 6 to "), "{said}");
+    let end = std::fs::read_to_string(dir.join("study.end_of_condition.csv")).unwrap();
+    let rows: Vec<&str> = end.lines().skip(1).collect();
+    assert_eq!(rows.len(), 1, "{end}");
+    assert!(
+        rows[0].starts_with("p001,mobility_limitation,c01,"),
+        "{end}"
+    );
     let out = common::hil(&["workload", "summary", "--data", csv.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout).to_string();
     assert!(
@@ -291,10 +302,10 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
         "no participant without a limitation: {text}"
     );
     let status = common::hil(&["study", "status", "--data", data.to_str().unwrap()]);
-    assert!(
-        String::from_utf8_lossy(&status.stdout)
-            .contains("p001 mobility_limitation: 2/2 conditions, 7 surveys")
-    );
+    assert!(String::from_utf8_lossy(&status.stdout).contains(
+        "p001 mobility_limitation: 2/2 conditions, 7 surveys (6 in the study CSV, \
+                 1 at the end of a query condition)"
+    ));
     let model = dir.join("m.json");
     let out = common::hil(&[
         "workload",

@@ -1,0 +1,3 @@
+//! The integration tests of `hil-http`, linked into one test binary.
+
+mod slow_clients;

@@ -189,8 +189,16 @@ impl<'t> Spans<'t> {
             return None;
         }
         let mut table = self.root.get_ref();
-        for key in keys {
-            match entry(table, key)?.1.get_ref() {
+        let mut rest = keys;
+        while let Some((key, tail)) = rest.split_first() {
+            let mut value = entry(table, key)?.1.get_ref();
+            rest = tail;
+            // Into an item of an array (of tables), as `[[methods]]`.
+            if let (DeValue::Array(items), Some((index, tail))) = (value, rest.split_first()) {
+                value = items.get(index.parse::<usize>().ok()?)?.get_ref();
+                rest = tail;
+            }
+            match value {
                 DeValue::Table(t) => table = t,
                 _ => return None,
             }
@@ -320,4 +328,50 @@ fn key_on_line(text: &str, offset: usize) -> Option<String> {
     }
     let key = line[..line.find('=')?].trim().trim_matches('"');
     (!key.is_empty()).then(|| key.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::{Deserialize, Deserializer};
+
+    /// A component that reads its table whole and checks it itself, so its
+    /// errors reach the locator as bare messages.
+    #[derive(Debug)]
+    struct ReadWhole;
+
+    impl<'de> Deserialize<'de> for ReadWhole {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            use serde::de::Error as _;
+            let table = toml::Table::deserialize(d)?;
+            match table.get("alpha") {
+                Some(toml::Value::Float(_)) | None => Ok(Self),
+                Some(_) => Err(D::Error::custom(
+                    "invalid type: string \"high\", expected f64",
+                )),
+            }
+        }
+    }
+
+    #[derive(Debug, Deserialize)]
+    #[allow(dead_code)]
+    struct Method {
+        label: String,
+        policy: ReadWhole,
+    }
+
+    #[derive(Debug, Deserialize)]
+    #[allow(dead_code)]
+    struct Study {
+        methods: Vec<Method>,
+    }
+
+    #[test]
+    fn a_bare_message_inside_an_array_of_tables_names_the_key_it_quotes() {
+        let text = "[[methods]]\nlabel = \"a\"\npolicy = { alpha = 0.5 }\n\
+                    [[methods]]\nlabel = \"b\"\n[methods.policy]\ntype = \"x\"\nalpha = \"high\"\n";
+        let e = parse_toml::<Study>(text, Path::new("s.toml")).unwrap_err();
+        assert_eq!(e.line, 8, "{e}");
+        assert_eq!(e.field.as_deref(), Some("methods.1.policy.alpha"), "{e}");
+    }
 }

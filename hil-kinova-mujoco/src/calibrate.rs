@@ -34,6 +34,7 @@ use std::time::{Duration, Instant};
 
 use hil_core::{ArmId, Environment, HilError, Result};
 use hil_jobs::Runner;
+use hil_paper::food_data::{HOLD_SECONDS, TRIALS_PER_SETTING};
 use hil_stats::{
     Alternative, Stat, binomial_pmf, binomial_se, binomial_upper_tail, bonferroni, convolve,
     fisher_exact,
@@ -99,7 +100,7 @@ pub struct SettingCell {
     pub published: Option<f64>,
     /// How likely a difference this large is by chance alone: Fisher's
     /// exact two-sided test that the counted attempts here and the
-    /// published ones ([`PUBLISHED_TRIALS_PER_SETTING`]) share one success
+    /// published ones ([`TRIALS_PER_SETTING`]) share one success
     /// rate. `None` when no attempt counted.
     pub p_value: Option<f64>,
 }
@@ -163,7 +164,7 @@ pub struct CalibrationReport {
     /// to show over the same overall rows: one whose true rate in every
     /// setting is the published one, so that only the sampling noise of
     /// both tables remains (the published cells rest on
-    /// [`PUBLISHED_TRIALS_PER_SETTING`] trials per setting; the simulated
+    /// [`TRIALS_PER_SETTING`] trials per setting; the simulated
     /// ones on the trials counted here). The floor `mean_abs_error` is to
     /// be read against.
     pub noise_floor: f64,
@@ -298,7 +299,7 @@ pub fn calibrate_with(
     let mut timing = (Duration::ZERO, Duration::ZERO);
     let mut cpu = Duration::ZERO;
     let mut steps = 0u64;
-    let mut hold_s = crate::sim::PUBLISHED_HOLD;
+    let mut hold_s = HOLD_SECONDS;
     for envs in &scenes {
         for env in envs.values() {
             let t = env.simulator().timing();
@@ -372,13 +373,9 @@ pub fn calibrate_with(
     })
 }
 
-/// Trials per (food, action, setting) behind the published rates (Feng et
-/// al. 2019: 10 per setting, 30 per overall cell).
-pub const PUBLISHED_TRIALS_PER_SETTING: usize = 10;
-
 /// The expected |simulated − published| of `row` for a simulator whose
 /// true rate in every setting equals the published one: the overall
-/// published rate is the sum of [`PUBLISHED_TRIALS_PER_SETTING`]-trial
+/// published rate is the sum of [`TRIALS_PER_SETTING`]-trial
 /// binomials over the row's settings, the simulated one the sum of
 /// binomials over the trials counted per setting; both distributions are
 /// enumerated exactly.
@@ -425,7 +422,7 @@ fn perfect_simulator_errors(row: &CalibrationRow) -> Vec<(f64, f64)> {
             convolve(&dist, &binomial_pmf(trials(c), c.published.unwrap_or(0.0)))
         })
     };
-    let published = sum_of(&|_| PUBLISHED_TRIALS_PER_SETTING);
+    let published = sum_of(&|_| TRIALS_PER_SETTING);
     let simulated = sum_of(&|c| c.trials - c.discarded);
     let (np, ns) = (published.len() - 1, simulated.len() - 1);
     if np == 0 || ns == 0 {
@@ -529,14 +526,14 @@ const TARGET_TOLERANCE: f64 = 1e-9;
 
 /// Fisher's exact two-sided p-value that the counted attempts of `t` and
 /// the published attempts behind `published` (one rate per setting, each
-/// over [`PUBLISHED_TRIALS_PER_SETTING`] trials) share one success rate;
+/// over [`TRIALS_PER_SETTING`] trials) share one success rate;
 /// `None` when no attempt counted or nothing was published (the test has
 /// no sample then).
 fn consistency_p(t: &Tally, published: &[f64]) -> Option<f64> {
-    let n = PUBLISHED_TRIALS_PER_SETTING as f64;
+    let n = TRIALS_PER_SETTING as f64;
     // A published rate is a count over its trials (0.4 = 4 of 10).
     let successes: u64 = published.iter().map(|p| (p * n).round() as u64).sum();
-    let trials = (PUBLISHED_TRIALS_PER_SETTING * published.len()) as u64;
+    let trials = (TRIALS_PER_SETTING * published.len()) as u64;
     let counted = (t.trials - t.discarded) as u64;
     fisher_exact(
         t.successes as u64,

@@ -31,9 +31,7 @@ use crate::controller::{ACTIONS, RollBy};
 use crate::food::{FoodKind, FoodModel, FoodProps, Setting, parse_labels};
 use crate::model::MjcfSource;
 use crate::perception::{Embedding, Observation, PerceptionNoise, RIM_RADIUS, perceive};
-use crate::sim::{
-    AttemptReport, KeyframeHook, LeafPlacement, PUBLISHED_HOLD, Placement, Simulator,
-};
+use crate::sim::{AttemptReport, KeyframeHook, LeafPlacement, Placement, Simulator};
 
 /// Configuration of [`KinovaFeedingEnv`] (`type = "kinova_feeding"`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -85,7 +83,7 @@ pub struct KinovaFeedingConfig {
 }
 
 fn default_hold() -> f64 {
-    PUBLISHED_HOLD
+    hil_paper::food_data::HOLD_SECONDS
 }
 
 fn default_plate() -> Vec<String> {
@@ -116,7 +114,7 @@ impl Default for KinovaFeedingConfig {
             noise: PerceptionNoise::default(),
             pretraining_trials: 0,
             pretrain_foods: Vec::new(),
-            hold_s: PUBLISHED_HOLD,
+            hold_s: hil_paper::food_data::HOLD_SECONDS,
             roll_by: RollBy::default(),
         }
     }

@@ -61,8 +61,8 @@ pub use attempt_log::AttemptLog;
 #[cfg(feature = "physics")]
 pub use calibrate::{
     AttemptRecord, CalibrationOptions, CalibrationOverSeeds, CalibrationReport, CalibrationRow,
-    CalibrationTarget, Consistency, PUBLISHED_TRIALS_PER_SETTING, SettingCell, TARGET_GRID,
-    calibrate, calibrate_over_seeds, calibrate_with, expected_abs_error_of_a_perfect_simulator,
+    CalibrationTarget, Consistency, SettingCell, TARGET_GRID, calibrate, calibrate_over_seeds,
+    calibrate_with, expected_abs_error_of_a_perfect_simulator,
 };
 #[cfg(feature = "physics")]
 pub use controller::{ACTIONS, Action, RollBy};
@@ -81,8 +81,7 @@ pub use model::MjcfSource;
 pub use render::{Keyframe, KeyframeRecorder, KeyframeWriter, RenderingEnv, View};
 #[cfg(feature = "physics")]
 pub use sim::{
-    AttemptReport, FREE_DT, MIN_TINES_TOUCHED, PUBLISHED_HOLD, PerceivedTarget, Placement,
-    Simulator, StopReason,
+    AttemptReport, FREE_DT, MIN_TINES_TOUCHED, PerceivedTarget, Placement, Simulator, StopReason,
 };
 #[cfg(feature = "physics")]
 pub use skewer::{MAX_DT, REF_DT};

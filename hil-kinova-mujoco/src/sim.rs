@@ -3,6 +3,7 @@
 
 use std::time::{Duration, Instant};
 
+use hil_paper::food_data::HOLD_SECONDS;
 use mujoco_rs::prelude::*;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use serde::Serialize;
@@ -27,9 +28,6 @@ const DEPTH_LIMIT: f64 = 0.035;
 const LIFT: f64 = 0.06;
 /// Duration of the lift (s): a mean speed of 10 cm/s.
 const LIFT_TIME: f64 = 0.6;
-/// How long the item must stay on the fork after the lift (s): the
-/// published success rule (Feng et al. 2019).
-pub const PUBLISHED_HOLD: f64 = 5.0;
 /// Smallest rotational inertia given to an item (kg·m²).
 const MIN_INERTIA: f64 = 3e-6;
 /// Height of the lettuce leaf's midrib above its blade (m, MJCF).
@@ -266,7 +264,7 @@ impl Simulator {
             target: None,
             dt,
             free_dt: FREE_DT,
-            hold: PUBLISHED_HOLD,
+            hold: HOLD_SECONDS,
             roll_by: RollBy::default(),
             contacts0,
             timing: Timing::default(),
@@ -274,7 +272,7 @@ impl Simulator {
     }
 
     /// Sets how long an item must stay on the lifted fork (s); the default
-    /// is the published [`PUBLISHED_HOLD`].
+    /// is the published [`HOLD_SECONDS`].
     pub fn set_hold(&mut self, seconds: f64) -> Result<(), KinovaError> {
         if !(seconds.is_finite() && (0.0..=60.0).contains(&seconds)) {
             return Err(KinovaError::InvalidHold { seconds });

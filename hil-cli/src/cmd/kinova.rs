@@ -313,7 +313,7 @@ fn print_run(opts: &CalibrationOptions, report: &CalibrationReport) {
         "a perfect simulator (true rates = the published ones) would still average {:.3}, with a worst cell of {:.3} expected: the sampling noise of {} published trials per setting and of these",
         report.noise_floor,
         report.noise_floor_worst_cell,
-        hil_kinova_mujoco::PUBLISHED_TRIALS_PER_SETTING
+        hil_paper::food_data::TRIALS_PER_SETTING
     );
     let t = report.target;
     println!(

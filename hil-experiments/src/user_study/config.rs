@@ -8,9 +8,10 @@ use hil_config::{
     BuildContext, EnvironmentConfig, QueryChannelConfig, WorkloadModelConfig, parse_toml,
 };
 use hil_core::{ConfigError, HilError, Result, SessionSettings};
+use hil_paper::user_study as paper_study;
 
 use crate::load_plugins;
-use crate::method::{Method, paper_policy};
+use crate::method::Method;
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -94,25 +95,16 @@ pub struct Validation {
     pub w_task: f64,
 }
 
-/// The testbed's figure w_task (0.7), used for the study's selection too.
-pub const PAPER_VALIDATION_W_TASK: f64 = 0.7;
-
 impl Default for Validation {
     fn default() -> Self {
         Self {
             plates: 4,
-            w_task: PAPER_VALIDATION_W_TASK,
+            // The testbed's figure w_task, used for the study's selection too.
+            w_task: hil_paper::simulation::FIGURE_W_TASK,
         }
     }
 }
 
-/// The study's attempts per item (N_att), as in the paper's user study.
-pub const PAPER_N_ATT: u32 = 3;
-/// Initial workload WL_0 of every plate.
-const PAPER_WL0: f64 = 0.5;
-/// LinUCB-QG's grid of workload weights w, chosen on validation (the
-/// simulated testbed's grid).
-pub const PAPER_W_GRID: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
 /// Simulated pretraining attempts per (food, action) in the MuJoCo scene:
 /// 10 per (food, action), 180 in all, so that the pretrained estimator's
 /// confidence bonuses are no longer dominated by the prior.
@@ -137,8 +129,8 @@ fn paper_repetitions() -> usize {
 }
 fn paper_session() -> SessionSettings {
     SessionSettings::default()
-        .with_n_att(PAPER_N_ATT)
-        .with_wl0(PAPER_WL0)
+        .with_n_att(paper_study::N_ATT)
+        .with_wl0(paper_study::WL0)
         .with_max_items(None)
 }
 /// The paper's scene, `kinova_feeding`, read through its config type as a
@@ -167,12 +159,12 @@ fn paper_channel() -> Box<dyn QueryChannelConfig> {
 }
 
 fn paper_methods() -> Vec<Method> {
-    vec![
-        Method::new("LinUCB", paper_policy("linucb", &[])),
-        Method::new("AlwaysQuery", paper_policy("always_query", &[])),
-        Method::new("LinUCB-QG", paper_policy("linucb_qg", &[("w", 1.0)]))
-            .tuned("w", &PAPER_W_GRID),
-    ]
+    // The methods the study ran, in the order of its published table; QG's
+    // w over the testbed's grid.
+    paper_study::OBJECTIVE
+        .iter()
+        .map(|row| Method::paper(row.method))
+        .collect()
 }
 
 /// `[session]`: the given keys over the paper's session.
@@ -197,7 +189,7 @@ impl UserStudyConfig {
     /// banana, baby carrot and cantaloupe, each item alone on the plate
     /// (`kinova_feeding`, `isolated`, 10 simulated pretraining attempts per
     /// food and action on foods off the plate, [`PAPER_PRETRAIN_FOODS`]); N_att = 3, WL_0 = 0.5; LinUCB, AlwaysQuery and
-    /// LinUCB-QG (α = 0.5, pretrained, w chosen from [`PAPER_W_GRID`] by
+    /// LinUCB-QG (α = 0.5, pretrained, w chosen from [`hil_paper::methods::QG_W_GRID`] by
     /// mean M_wt(0.7) over 4 validation plates per value); the bundled `f12_sim`
     /// workload model (a query never lowers its forecast); a perfect `simulated_expert`
     /// answering; 2 repetitions; seed 7. `examples/configs/user-study.toml`

@@ -55,15 +55,11 @@ mod keyframes;
 mod run;
 mod seeds;
 
-pub use config::{
-    PAPER_N_ATT, PAPER_VALIDATION_W_TASK, PAPER_W_GRID, PAPER_WORKLOAD, UserStudyConfig, Validation,
-};
+pub use config::{PAPER_WORKLOAD, UserStudyConfig, Validation};
 #[cfg(feature = "physics")]
 pub use keyframes::{Keyframes, PicturedStudy};
 pub use run::{
     Episode, MethodSummary, Plate, PlateResult, Protocol, Selection, UserStudy, UserStudyResult,
     method_order,
 };
-pub use seeds::{
-    ChosenAcrossSeeds, MethodAcrossSeeds, PAPER_STUDY, UserStudyOverSeeds, across_seeds,
-};
+pub use seeds::{ChosenAcrossSeeds, MethodAcrossSeeds, UserStudyOverSeeds, across_seeds};

@@ -8,20 +8,12 @@ use std::path::Path;
 
 use hil_core::{HilError, Result};
 use hil_jobs::Runner;
+use hil_paper::methods::PaperMethod;
 use hil_stats::Stat;
 use serde::Serialize;
 
 use super::config::UserStudyConfig;
 use super::run::{MethodSummary, Protocol, Selection, UserStudyResult};
-
-/// The paper's real-robot user study, per method: (label, r_task_avg,
-/// n_success per plate, n_q per plate), means (the paper's user-study
-/// table).
-pub const PAPER_STUDY: [(&str, f64, f64, f64); 3] = [
-    ("LinUCB", 0.38, 2.00, 0.0),
-    ("AlwaysQuery", 0.87, 2.68, 3.0),
-    ("LinUCB-QG", 0.68, 2.53, 1.74),
-];
 
 /// One method over many seeds: each figure is the mean ± standard error
 /// over seeds of each seed's mean per plate.
@@ -46,7 +38,7 @@ pub struct MethodAcrossSeeds {
     #[serde(with = "hil_stats::summary::as_mean_sem::seq")]
     pub n_q_per_plate_by_attempt: Vec<Stat>,
     /// The paper's real-study figures for a method of this label:
-    /// r_task_avg, n_success and n_q per plate ([`PAPER_STUDY`]).
+    /// r_task_avg, n_success and n_q per plate ([`hil_paper::user_study::OBJECTIVE`]).
     pub paper: Option<[f64; 3]>,
 }
 
@@ -98,10 +90,9 @@ fn of_method(runs: &[UserStudyResult], label: &str) -> MethodAcrossSeeds {
         n_q_per_plate_by_attempt: (0..depth)
             .map(|i| over(&|m| m.n_q_by_attempt.get(i).copied().unwrap_or(0.0)))
             .collect(),
-        paper: PAPER_STUDY
-            .iter()
-            .find(|p| p.0 == label)
-            .map(|p| [p.1, p.2, p.3]),
+        paper: PaperMethod::from_label(label)
+            .and_then(hil_paper::user_study::row)
+            .map(|p| [p.r_task_avg.mean, p.n_success.mean, p.n_q_mean()]),
     }
 }
 

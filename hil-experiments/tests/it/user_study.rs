@@ -245,7 +245,7 @@ fn run_with_lets_the_caller_observe_every_plate() {
             |_| {},
         )
         .unwrap();
-    let validation = 4 * hil_experiments::user_study::PAPER_W_GRID.len();
+    let validation = 4 * hil_paper::methods::QG_W_GRID.len();
     assert!(plates[..validation].iter().all(|p| p == "validation"));
     assert_eq!(plates[validation..], ["LinUCB", "AlwaysQuery", "LinUCB-QG"]);
     assert_eq!(

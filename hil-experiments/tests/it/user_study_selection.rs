@@ -5,7 +5,8 @@
 use std::path::Path;
 
 use hil_core::WorkloadInput;
-use hil_experiments::user_study::{PAPER_W_GRID, UserStudyConfig};
+use hil_experiments::user_study::UserStudyConfig;
+use hil_paper::methods::QG_W_GRID;
 
 /// A cheap environment in place of the MuJoCo scene (the bundled synthetic
 /// food dataset), with pretraining foods because the methods pretrain.
@@ -72,7 +73,7 @@ policy = {{ type = "linucb_qg", alpha = 0.5, lambda = 1.0, w = {}, pretrain = tr
 fn the_paper_protocol_chooses_w_on_validation_not_by_hand() {
     let cfg = UserStudyConfig::paper();
     let qg = cfg.methods.iter().find(|m| m.label == "LinUCB-QG").unwrap();
-    assert_eq!(qg.tune.get("w").map(Vec::as_slice), Some(&PAPER_W_GRID[..]));
+    assert_eq!(qg.tune.get("w").map(Vec::as_slice), Some(&QG_W_GRID[..]));
     assert!(cfg.validation.plates >= 1);
     // The other methods have nothing to tune.
     assert!(

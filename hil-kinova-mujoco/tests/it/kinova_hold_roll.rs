@@ -3,9 +3,9 @@
 //! pitch β and roll γ through the fork's joints while the arm holds the
 //! handle's orientation.
 
-use hil_kinova_mujoco::{
-    ACTIONS, Action, FoodKind, KinovaError, PUBLISHED_HOLD, RollBy, Simulator, StopReason,
-};
+use hil_kinova_mujoco::{ACTIONS, Action, FoodKind, KinovaError, RollBy, Simulator, StopReason};
+
+use hil_paper::food_data::HOLD_SECONDS;
 
 use crate::common::{assert_reached, attempt_at};
 
@@ -30,8 +30,8 @@ fn attempt(
 #[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn skewered_items_stay_on_the_fork_through_the_5_s_hold() {
     let mut sim = Simulator::new().unwrap();
-    assert_eq!(sim.hold(), PUBLISHED_HOLD);
-    assert_eq!(PUBLISHED_HOLD, 5.0);
+    assert_eq!(sim.hold(), HOLD_SECONDS);
+    assert_eq!(HOLD_SECONDS, 5.0);
     // Actions that skewer these foods well (published rates 0.43–0.93).
     let cases = [
         (FoodKind::Cantaloupe, "VS0"),
@@ -61,7 +61,7 @@ fn skewered_items_stay_on_the_fork_through_the_5_s_hold() {
                 "{kind:?} {name} seed {seed}: crept {:.1} mm along the tines",
                 1000.0 * r.hold_slip
             );
-            assert!(r.sim_time > PUBLISHED_HOLD, "{r:?}");
+            assert!(r.sim_time > HOLD_SECONDS, "{r:?}");
         }
     }
     assert!(lifted >= 8, "only {lifted} of 24 attempts lifted an item");

@@ -33,3 +33,15 @@ pub fn mujoco_rpath() {
     }
     println!("cargo::rustc-link-arg=-Wl,-rpath,{dir}");
 }
+
+/// The same rpath for a package that has no `physics` feature of its own
+/// but may link MuJoCo through another package's (the workspace's
+/// integration tests, which link hil-experiments): added whenever
+/// `MUJOCO_DYNAMIC_LINK_DIR` is set, silently, since an rpath to a
+/// directory nothing is loaded from is harmless.
+pub fn mujoco_rpath_unconditional() {
+    println!("cargo::rerun-if-env-changed=MUJOCO_DYNAMIC_LINK_DIR");
+    if let Ok(dir) = std::env::var("MUJOCO_DYNAMIC_LINK_DIR") {
+        println!("cargo::rustc-link-arg=-Wl,-rpath,{dir}");
+    }
+}

@@ -81,8 +81,19 @@ fn from_toml<T: DeserializeOwned>(text: &str, path: &Path, e: &toml::de::Error) 
         }
     };
     let (line, column) = at.map_or((0, 0), |a| line_col(text, a));
-    let field = (!keys.is_empty()).then(|| keys.join("."));
-    ConfigError::new(path, line, column, field, message)
+    ConfigError::new(path, line, column, field_name(&keys), message)
+}
+
+/// The field a message names: the keys, without the indices of array
+/// items (`methods.policy.alpha` for `methods.0.policy.alpha`); the line
+/// tells which item.
+fn field_name(keys: &[String]) -> Option<String> {
+    let named: Vec<&str> = keys
+        .iter()
+        .map(String::as_str)
+        .filter(|k| k.parse::<usize>().is_err())
+        .collect();
+    (!named.is_empty()).then(|| named.join("."))
 }
 
 /// The error `e` raised by validating the table at `section` of a config
@@ -130,8 +141,7 @@ pub fn error_at_key(text: &str, path: &Path, key_path: &[&str], message: String)
 fn at_keys(text: &str, path: &Path, keys: &[String], message: &str) -> ConfigError {
     let at = Spans::parse(text).and_then(|s| s.key_start(keys));
     let (line, column) = at.map_or((0, 0), |a| line_col(text, a));
-    let field = (!keys.is_empty()).then(|| keys.join("."));
-    ConfigError::new(path, line, column, field, message)
+    ConfigError::new(path, line, column, field_name(keys), message)
 }
 
 /// The spans of every key and value of a TOML document, from toml's parser.
@@ -372,6 +382,6 @@ mod tests {
                     [[methods]]\nlabel = \"b\"\n[methods.policy]\ntype = \"x\"\nalpha = \"high\"\n";
         let e = parse_toml::<Study>(text, Path::new("s.toml")).unwrap_err();
         assert_eq!(e.line, 8, "{e}");
-        assert_eq!(e.field.as_deref(), Some("methods.1.policy.alpha"), "{e}");
+        assert_eq!(e.field.as_deref(), Some("methods.policy.alpha"), "{e}");
     }
 }

@@ -294,16 +294,23 @@ impl UserStudyConfig {
         }
         let mut seen = HashSet::new();
         for (i, m) in self.methods.iter().enumerate() {
+            let index = i.to_string();
+            // A label error names which method's label it is.
+            let at_label = |msg: &str| {
+                let mut e = at(&["methods", &index, "label"], msg);
+                e.field = Some(format!("methods[{i}].label"));
+                e
+            };
             if m.label.trim().is_empty() {
-                return Err(located_label(text, path, i, "must not be empty"));
+                return Err(at_label("must not be empty"));
             }
             if !seen.insert(m.label.as_str()) {
                 let msg = format!("`{}` names two methods; labels must be unique", m.label);
-                return Err(located_label(text, path, i, &msg));
+                return Err(at_label(&msg));
             }
             if m.tune.len() > 1 || m.tune.values().any(|g| g.is_empty()) {
                 return Err(at(
-                    &["methods", "tune"],
+                    &["methods", &index, "tune"],
                     "tune at most one hyperparameter, over at least one value",
                 ));
             }
@@ -337,38 +344,4 @@ impl UserStudyConfig {
 /// Whether study TOML `text` (already parsed once) has an `environment` key.
 fn names_environment(text: &str) -> bool {
     toml::from_str::<toml::Table>(text).is_ok_and(|t| t.contains_key("environment"))
-}
-
-/// An error at the label of method `index` (0-based): the line of the
-/// `index`-th `[[methods]]` entry's `label` when the file writes methods as
-/// an array of tables, else wherever [`ConfigError::at_key`] finds `label`.
-fn located_label(text: &str, path: &Path, index: usize, message: &str) -> ConfigError {
-    let mut err = hil_config::error_at_key(text, path, &["methods", "label"], message.to_string());
-    let mut entry = None;
-    for (n, line) in text.lines().enumerate() {
-        let l = line.trim_start();
-        if l.starts_with("[[") {
-            let header = l.trim_start_matches("[[").split("]]").next().unwrap_or("");
-            entry = if header.trim() == "methods" {
-                Some(entry.map_or(0, |e: usize| e + 1))
-            } else {
-                None
-            };
-        } else if l.starts_with('[') {
-            // A sub-table such as `[methods.policy]` belongs to the entry;
-            // any other table ends it.
-            if !l.starts_with("[methods.") {
-                entry = None;
-            }
-        } else if entry == Some(index)
-            && l.split('=').next().map(str::trim) == Some("label")
-            && l.contains('=')
-        {
-            err.line = n + 1;
-            err.column = 1;
-            break;
-        }
-    }
-    err.field = Some(format!("methods[{index}].label"));
-    err
 }

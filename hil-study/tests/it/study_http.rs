@@ -4,7 +4,7 @@
 //! located config errors.
 
 use std::net::SocketAddr;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use hil_core::HilError;
@@ -19,6 +19,31 @@ fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hil-study-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
+}
+
+/// Waits until nothing holds the data folder's lock. A dropped server has
+/// closed its lock file, but a child process that another test forked at
+/// that moment shares the open file until it execs, and holds the lock
+/// that long.
+fn wait_for_lock_release(dir: &Path) {
+    let path = dir.join("study.lock");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let file = std::fs::File::open(&path).unwrap();
+        // Dropping `file` releases the lock it took. (`File::try_lock` is
+        // what the server locks with; see its note on the MSRV.)
+        #[allow(clippy::incompatible_msrv)]
+        let free = file.try_lock().is_ok();
+        if free {
+            return;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "{} stayed locked",
+            path.display()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
 
 fn config(extra: &str) -> StudyConfig {
@@ -230,6 +255,7 @@ fn tokens_origins_and_repeated_or_bad_submissions() {
     // A second server on the same folder is refused while this one runs.
     assert!(StudyServer::start(config(""), &dir).is_err());
     drop(server);
+    wait_for_lock_release(&dir);
     // Another design on the same folder is refused.
     let other = StudyConfig::parse(
         &CONFIG.replace("intervals_min = [2]", "intervals_min = [1]"),
@@ -355,6 +381,7 @@ fn a_log_line_about_another_condition_is_refused_in_plain_words() {
     let server = StudyServer::start(config(""), &dir).unwrap();
     server.enrol(Population::NoLimitation).unwrap();
     drop(server);
+    wait_for_lock_release(&dir);
     // The participant is at the query condition c01 (baselines come last).
     let log = dir.join("participants/p001.jsonl");
     let mut text = std::fs::read_to_string(&log).unwrap();

@@ -140,8 +140,7 @@ impl ExperimentConfig {
 
     /// Reads and validates an experiment file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
-        Ok(Self::parse(&text, path)?)
+        read_config_file(path, Self::parse)
     }
 
     /// Parses experiment TOML. `path` names the file in error messages, and
@@ -149,8 +148,7 @@ impl ExperimentConfig {
     /// (see [`hil_plugin::load`]) before the components are parsed, so
     /// plugin types are usable wherever built-in ones are.
     pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
-        load_plugins(text, path)?;
-        let cfg: Self = parse_toml(text, path)?;
+        let cfg: Self = parse_listing_plugins(text, path)?;
         let located = |section: &[&str], e: HilError| error_in_section(text, path, section, e);
         limits::check_count("episodes", cfg.episodes, limits::EPISODES)
             .map_err(|e| located(&[], e))?;
@@ -177,6 +175,28 @@ impl ExperimentConfig {
         }
         Ok(cfg)
     }
+}
+
+/// Reads a config file (at most [`limits::CONFIG`](hil_core::files::limits::CONFIG)
+/// bytes) and parses it with `parse`: the one reader of every TOML file
+/// that may list plugins.
+pub(crate) fn read_config_file<T>(
+    path: &Path,
+    parse: impl FnOnce(&str, &Path) -> std::result::Result<T, ConfigError>,
+) -> Result<T> {
+    let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
+    Ok(parse(&text, path)?)
+}
+
+/// Loads the `plugins` a config file lists (see [`load_plugins`]), then
+/// parses the whole file as `T`, so plugin types are usable wherever
+/// built-in ones are.
+pub(crate) fn parse_listing_plugins<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &Path,
+) -> std::result::Result<T, ConfigError> {
+    load_plugins(text, path)?;
+    parse_toml(text, path)
 }
 
 /// Loads the `plugins` a config file lists (a top-level `plugins` array),

@@ -1,7 +1,7 @@
 //! Runs one attempt of every action on every food and prints the reports.
 //!
 //! `cargo run -p hil-kinova-mujoco --example attempt`
-use hil_kinova_mujoco::{ACTIONS, FoodKind, FoodModel, Placement, Simulator};
+use hil_kinova_mujoco::{FoodKind, FoodModel, Placement, Simulator, actions};
 use rand::SeedableRng;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -9,7 +9,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("home {:?}", sim.home());
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
     for kind in FoodKind::SCENE {
-        for a in &ACTIONS {
+        for a in actions() {
             let props = FoodModel::default_for(kind).sample(&mut rng);
             let items = vec![Placement {
                 props,

@@ -7,8 +7,8 @@
 //! `cargo run --release -p hil-kinova-mujoco --features render --example gallery -- hil-kinova-mujoco/docs`
 use hil_core::{ArmId, Environment};
 use hil_kinova_mujoco::{
-    ACTIONS, KeyframeRecorder, KeyframeWriter, KinovaFeedingConfig, KinovaFeedingEnv, RenderingEnv,
-    View,
+    KeyframeRecorder, KeyframeWriter, KinovaFeedingConfig, KinovaFeedingEnv, RenderingEnv, View,
+    actions,
 };
 
 /// Master seed of every attempt (the item's size and yaw, perception noise).
@@ -30,7 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         height: 300,
     };
     let mut writer = KeyframeWriter::with_view(dir.as_ref(), env.simulator(), &view)?;
-    for (a, action) in ACTIONS.iter().enumerate() {
+    for (a, action) in actions().iter().enumerate() {
         let mut rec = KeyframeRecorder::default();
         rec.set_prefix(action.name.to_lowercase());
         let success = {

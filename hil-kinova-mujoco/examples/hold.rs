@@ -4,7 +4,7 @@
 //! along the tines during the hold.
 //!
 //! `cargo run --release -p hil-kinova-mujoco --example hold -- [trials] [hold_s] [free_step_s]`
-use hil_kinova_mujoco::{ACTIONS, FoodKind, FoodModel, Placement, Simulator};
+use hil_kinova_mujoco::{FoodKind, FoodModel, Placement, Simulator, actions};
 use rand::SeedableRng;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -18,7 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut steps = 0u64;
     sim.set_hold(hold)?;
     for kind in FoodKind::SCENE {
-        for a in &ACTIONS {
+        for a in actions() {
             let (mut lifted, mut held, mut slip, mut pierced) = (0, 0, 0.0, 0);
             for t in 0..trials {
                 let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1000 + t as u64);

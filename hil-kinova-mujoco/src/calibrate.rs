@@ -24,7 +24,7 @@
 //! // VS90 on carrot: published 1.0 when isolated (0.53 over all settings).
 //! assert_eq!(report.rows[1].by_setting[0].published, Some(1.0));
 //! assert_eq!(report.rows[1].published, Some(1.0));
-//! assert_eq!(report.rows[1].trials, 1);
+//! assert_eq!(report.rows[1].counts.trials, 1);
 //! # Ok::<(), hil_core::HilError>(())
 //! ```
 
@@ -41,7 +41,7 @@ use hil_stats::{
 };
 use serde::Serialize;
 
-use crate::controller::{ACTIONS, RollBy};
+use crate::controller::{RollBy, actions};
 use crate::env::{KinovaFeedingConfig, KinovaFeedingEnv};
 use crate::food::{FoodKind, Setting};
 use crate::sim::AttemptReport;
@@ -85,17 +85,9 @@ impl Default for CalibrationOptions {
 pub struct SettingCell {
     /// The setting.
     pub setting: Setting,
-    /// Trials run.
-    pub trials: usize,
-    /// Trials discarded under the published rule (fewer than
-    /// [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines touched the item).
-    pub discarded: usize,
-    /// Successes.
-    pub successes: usize,
-    /// Achieved success rate over the trials that counted.
-    pub rate: f64,
-    /// Binomial standard error of `rate`, √(p(1−p)/n).
-    pub se: f64,
+    /// Trials, discards, successes, and the achieved rate with its SE.
+    #[serde(flatten)]
+    pub counts: Tally,
     /// Published rate in this setting.
     pub published: Option<f64>,
     /// How likely a difference this large is by chance alone: Fisher's
@@ -112,17 +104,9 @@ pub struct CalibrationRow {
     pub food: String,
     /// Action label.
     pub action: String,
-    /// Trials run.
-    pub trials: usize,
-    /// Trials discarded under the published rule (fewer than
-    /// [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines touched the item).
-    pub discarded: usize,
-    /// Successes.
-    pub successes: usize,
-    /// Achieved success rate over the trials that counted.
-    pub rate: f64,
-    /// Binomial standard error of `rate`, √(p(1−p)/n).
-    pub se: f64,
+    /// Trials, discards, successes, and the achieved rate with its SE.
+    #[serde(flatten)]
+    pub counts: Tally,
     /// Published rate (setting `all`) when the trials cover all three
     /// settings equally; otherwise the mean of the published rates of the
     /// settings run.
@@ -255,7 +239,7 @@ pub fn calibrate_with(
         .foods
         .iter()
         .flat_map(|&f| {
-            (0..ACTIONS.len()).flat_map(move |a| (0..opts.trials).map(move |t| (f, a, t)))
+            (0..actions().len()).flat_map(move |a| (0..opts.trials).map(move |t| (f, a, t)))
         })
         .collect();
     let total = jobs.len();
@@ -328,7 +312,7 @@ pub fn calibrate_with(
     let compared: Vec<&CalibrationRow> = rows.iter().filter(|r| r.published.is_some()).collect();
     let errors: Vec<f64> = compared
         .iter()
-        .filter_map(|r| r.published.map(|p| (p - r.rate).abs()))
+        .filter_map(|r| r.published.map(|p| (p - r.counts.rate).abs()))
         .collect();
     let max_abs_error = errors.iter().copied().fold(0.0, f64::max);
     let mean_abs_error = mean(errors);
@@ -361,7 +345,7 @@ pub fn calibrate_with(
         mean_abs_error_by_setting: mean(
             rows.iter()
                 .flat_map(|r| &r.by_setting)
-                .filter_map(|c| c.published.map(|p| (p - c.rate).abs()))
+                .filter_map(|c| c.published.map(|p| (p - c.counts.rate).abs()))
                 .collect(),
         ),
         attempts_per_second: total as f64 / wall.max(1e-9),
@@ -423,7 +407,7 @@ fn perfect_simulator_errors(row: &CalibrationRow) -> Vec<(f64, f64)> {
         })
     };
     let published = sum_of(&|_| TRIALS_PER_SETTING);
-    let simulated = sum_of(&|c| c.trials - c.discarded);
+    let simulated = sum_of(&|c| c.counts.trials - c.counts.discarded);
     let (np, ns) = (published.len() - 1, simulated.len() - 1);
     if np == 0 || ns == 0 {
         return vec![(0.0, 1.0)];
@@ -610,12 +594,19 @@ impl Consistency {
 
 /// Trials, discarded trials and successes among some attempts, and the
 /// success rate over those that counted with its binomial SE.
-struct Tally {
-    trials: usize,
-    discarded: usize,
-    successes: usize,
-    rate: f64,
-    se: f64,
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Tally {
+    /// Trials run.
+    pub trials: usize,
+    /// Trials discarded under the published rule (fewer than
+    /// [`MIN_TINES_TOUCHED`](crate::MIN_TINES_TOUCHED) tines touched the item).
+    pub discarded: usize,
+    /// Successes.
+    pub successes: usize,
+    /// Achieved success rate over the trials that counted.
+    pub rate: f64,
+    /// Binomial standard error of `rate`, √(p(1−p)/n).
+    pub se: f64,
 }
 
 /// Tallies `records`: an attempt in which fewer than
@@ -771,29 +762,27 @@ fn pool_rows(runs: &[CalibrationReport]) -> Vec<CalibrationRow> {
                 .map(|(j, cell)| {
                     let (n, d, s) = sum(&|r| {
                         let c = &r.rows[i].by_setting[j];
-                        (c.trials, c.discarded, c.successes)
+                        (c.counts.trials, c.counts.discarded, c.counts.successes)
                     });
                     let t = Tally::of(n, d, s);
                     SettingCell {
                         p_value: consistency_p(&t, cell.published.as_slice()),
-                        trials: t.trials,
-                        discarded: t.discarded,
-                        successes: t.successes,
-                        rate: t.rate,
-                        se: t.se,
+                        counts: t,
                         ..cell.clone()
                     }
                 })
                 .collect();
-            let (n, d, s) = sum(&|r| (r.rows[i].trials, r.rows[i].discarded, r.rows[i].successes));
+            let (n, d, s) = sum(&|r| {
+                (
+                    r.rows[i].counts.trials,
+                    r.rows[i].counts.discarded,
+                    r.rows[i].counts.successes,
+                )
+            });
             let t = Tally::of(n, d, s);
             CalibrationRow {
                 p_value: row_p_value(&t, &by_setting),
-                trials: t.trials,
-                discarded: t.discarded,
-                successes: t.successes,
-                rate: t.rate,
-                se: t.se,
+                counts: t,
                 by_setting,
                 ..row.clone()
             }
@@ -805,7 +794,7 @@ fn pool_rows(runs: &[CalibrationReport]) -> Vec<CalibrationRow> {
 fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<CalibrationRow> {
     let mut rows = Vec::new();
     for &food in &opts.foods {
-        for (a, action) in ACTIONS.iter().enumerate() {
+        for (a, action) in actions().iter().enumerate() {
             let cell: Vec<&AttemptRecord> = records
                 .iter()
                 .filter(|r| r.food == food && r.report.action == action.name)
@@ -820,13 +809,9 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                     let published = food.published_rates_in(setting)[a];
                     SettingCell {
                         setting,
-                        trials: t.trials,
-                        discarded: t.discarded,
-                        successes: t.successes,
-                        rate: t.rate,
-                        se: t.se,
-                        published: Some(published),
                         p_value: consistency_p(&t, &[published]),
+                        counts: t,
+                        published: Some(published),
                     }
                 })
                 .collect();
@@ -835,14 +820,16 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
             // `all` row applies; otherwise the trial-weighted mean of the
             // settings run.
             let covers_all = Setting::ALL.iter().all(|s| opts.settings.contains(s))
-                && by_setting.iter().all(|c| c.trials == by_setting[0].trials);
+                && by_setting
+                    .iter()
+                    .all(|c| c.counts.trials == by_setting[0].counts.trials);
             let published = if covers_all {
                 Some(food.published_rates()[a])
             } else {
                 Some(
                     by_setting
                         .iter()
-                        .map(|c| food.published_rates_in(c.setting)[a] * c.trials as f64)
+                        .map(|c| food.published_rates_in(c.setting)[a] * c.counts.trials as f64)
                         .sum::<f64>()
                         / t.trials.max(1) as f64,
                 )
@@ -851,11 +838,7 @@ fn tabulate(opts: &CalibrationOptions, records: &[AttemptRecord]) -> Vec<Calibra
                 p_value: row_p_value(&t, &by_setting),
                 food: food.name().into(),
                 action: action.name.into(),
-                trials: t.trials,
-                discarded: t.discarded,
-                successes: t.successes,
-                rate: t.rate,
-                se: t.se,
+                counts: t,
                 published,
                 by_setting,
             });
@@ -877,7 +860,7 @@ mod tests {
             trial: 0,
             seed: 0,
             report: AttemptReport {
-                action: ACTIONS[0].name,
+                action: actions()[0].name,
                 food: FoodKind::Banana,
                 success,
                 reached_pitch: 0.0,
@@ -933,22 +916,14 @@ mod tests {
     fn one_setting_row(published: f64, trials: usize) -> CalibrationRow {
         let cell = SettingCell {
             setting: Setting::Isolated,
-            trials,
-            discarded: 0,
-            successes: 0,
-            rate: 0.0,
-            se: 0.0,
+            counts: Tally::of(trials, 0, 0),
             published: Some(published),
             p_value: None,
         };
         CalibrationRow {
             food: "banana".into(),
             action: "VS0".into(),
-            trials: cell.trials,
-            discarded: cell.discarded,
-            successes: cell.successes,
-            rate: cell.rate,
-            se: cell.se,
+            counts: cell.counts.clone(),
             published: cell.published,
             p_value: cell.p_value,
             by_setting: vec![cell],
@@ -1047,11 +1022,18 @@ mod tests {
         ];
         let rows = tabulate(&opts, &records);
         let vs0 = &rows[0];
-        assert_eq!((vs0.trials, vs0.discarded, vs0.successes), (4, 2, 1));
-        assert_eq!(vs0.rate, 0.5);
-        assert_eq!(vs0.se, binomial_se(1, 2));
-        assert_eq!(vs0.by_setting[0].discarded, 2);
-        assert_eq!(vs0.by_setting[0].rate, 0.5);
+        assert_eq!(
+            (
+                vs0.counts.trials,
+                vs0.counts.discarded,
+                vs0.counts.successes
+            ),
+            (4, 2, 1)
+        );
+        assert_eq!(vs0.counts.rate, 0.5);
+        assert_eq!(vs0.counts.se, binomial_se(1, 2));
+        assert_eq!(vs0.by_setting[0].counts.discarded, 2);
+        assert_eq!(vs0.by_setting[0].counts.rate, 0.5);
         // The consistency test sees the 2 counted attempts (1 success)
         // against the published 0 of 10: of the 12 attempts' single
         // success, the simulated 2 hold it with probability 2/12, and the
@@ -1102,10 +1084,17 @@ mod tests {
         // Pooled counts are the sums; rates and p-values follow from them.
         for (i, row) in over.pooled.iter().enumerate() {
             let (a, b) = (&single[0].rows[i], &single[1].rows[i]);
-            assert_eq!(row.successes, a.successes + b.successes);
-            assert_eq!(row.trials, 4);
-            let t = Tally::of(row.trials, row.discarded, row.successes);
-            assert_eq!((row.rate, row.se), (t.rate, t.se));
+            assert_eq!(
+                row.counts.successes,
+                a.counts.successes + b.counts.successes
+            );
+            assert_eq!(row.counts.trials, 4);
+            let t = Tally::of(
+                row.counts.trials,
+                row.counts.discarded,
+                row.counts.successes,
+            );
+            assert_eq!(row.counts, t);
             let published = [
                 FoodKind::Carrot.published_rates_in(Setting::Isolated)[i],
                 FoodKind::Carrot.published_rates_in(Setting::Lettuce)[i],
@@ -1113,8 +1102,8 @@ mod tests {
             assert_eq!(row.p_value, consistency_p(&t, &published));
             for (j, cell) in row.by_setting.iter().enumerate() {
                 assert_eq!(
-                    cell.successes,
-                    a.by_setting[j].successes + b.by_setting[j].successes
+                    cell.counts.successes,
+                    a.by_setting[j].counts.successes + b.by_setting[j].counts.successes
                 );
             }
         }

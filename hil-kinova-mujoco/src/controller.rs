@@ -16,6 +16,8 @@
 //! joint positions only (what a robot's trajectory generator knows); the
 //! physical arm follows through its joint servos.
 
+use std::sync::OnceLock;
+
 use mujoco_rs::prelude::*;
 use nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
 
@@ -25,8 +27,10 @@ use crate::model::SceneIds;
 /// One skewering action.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Action {
-    /// Label (VS0 ... TA90), in the order of `hil_envs::feeding::action_space`.
+    /// Label (VS0 ... TA90), as in `hil_envs::feeding::action_space`.
     pub name: &'static str,
+    /// The pitch family the label names.
+    pub family: PitchFamily,
     /// Fork pitch β (rad).
     pub pitch: f64,
     /// Tine-row angle to the major axis (rad).
@@ -34,60 +38,120 @@ pub struct Action {
     /// Force threshold ending penetration (N).
     pub max_force: f64,
     /// Angle of the move-in from vertical (rad), leaning the way the tines
-    /// lean: 0 for VS and TV, whose approach is vertical, and atan(1/2) for
-    /// TA, whose move-in has a vertical component twice the horizontal one
-    /// (ADA's Gen3 skewering, fact sheet §3).
+    /// lean ([`PitchFamily::approach_tilt`]).
     pub approach_tilt: f64,
 }
 
 /// TA's move-in: vertical component twice the horizontal (atan(1/2), rad).
 const TA_APPROACH_TILT: f64 = 0.463_647_609_000_806_1;
 
-/// The six actions in hil-core's arm order: VS0 VS90 TV0 TV90 TA0 TA90.
-pub const ACTIONS: [Action; 6] = [
-    Action {
-        name: "VS0",
-        pitch: 0.0,
-        roll: 0.0,
-        max_force: 25.0,
-        approach_tilt: 0.0,
-    },
-    Action {
-        name: "VS90",
-        pitch: 0.0,
-        roll: std::f64::consts::FRAC_PI_2,
-        max_force: 25.0,
-        approach_tilt: 0.0,
-    },
-    Action {
-        name: "TV0",
-        pitch: -0.5,
-        roll: 0.0,
-        max_force: 20.0,
-        approach_tilt: 0.0,
-    },
-    Action {
-        name: "TV90",
-        pitch: -0.5,
-        roll: std::f64::consts::FRAC_PI_2,
-        max_force: 20.0,
-        approach_tilt: 0.0,
-    },
-    Action {
-        name: "TA0",
-        pitch: 0.4,
-        roll: 0.0,
-        max_force: 10.0,
-        approach_tilt: TA_APPROACH_TILT,
-    },
-    Action {
-        name: "TA90",
-        pitch: 0.4,
-        roll: std::f64::consts::FRAC_PI_2,
-        max_force: 10.0,
-        approach_tilt: TA_APPROACH_TILT,
-    },
-];
+/// The fork's mechanics per pitch family (VS, TV, TA): the pitch β, the
+/// force threshold ending penetration and the move-in tilt. The roll is the
+/// other half of an action's name (`0` or `90` degrees to the major axis).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum PitchFamily {
+    /// Vertical skewer: tines straight down, vertical approach.
+    Vs,
+    /// Tilted vertical: tines leaning back, vertical approach.
+    Tv,
+    /// Tilted angled: tines leaning forward, approach along the lean.
+    Ta,
+}
+
+impl PitchFamily {
+    /// The family named by an action label's prefix (`VS`, `TV`, `TA`).
+    fn from_prefix(prefix: &str) -> Option<Self> {
+        match prefix {
+            "VS" => Some(Self::Vs),
+            "TV" => Some(Self::Tv),
+            "TA" => Some(Self::Ta),
+            _ => None,
+        }
+    }
+
+    /// Fork pitch β (rad).
+    pub fn pitch(self) -> f64 {
+        match self {
+            Self::Vs => 0.0,
+            Self::Tv => -0.5,
+            Self::Ta => 0.4,
+        }
+    }
+
+    /// Force threshold ending penetration (N).
+    pub fn max_force(self) -> f64 {
+        match self {
+            Self::Vs => 25.0,
+            Self::Tv => 20.0,
+            Self::Ta => 10.0,
+        }
+    }
+
+    /// Angle of the move-in from vertical (rad): 0 for VS and TV, whose
+    /// approach is vertical, and atan(1/2) for TA (ADA's Gen3 skewering,
+    /// fact sheet §3).
+    pub fn approach_tilt(self) -> f64 {
+        match self {
+            Self::Vs | Self::Tv => 0.0,
+            Self::Ta => TA_APPROACH_TILT,
+        }
+    }
+}
+
+impl Action {
+    /// The mechanics of the feeding task's action labelled `name`: a pitch
+    /// family (`VS`, `TV`, `TA`) followed by the tine row's angle to the
+    /// food's major axis in degrees (`0` or `90`), e.g. `TV90`.
+    ///
+    /// ```
+    /// let a = hil_kinova_mujoco::Action::from_label("TV90").unwrap();
+    /// assert_eq!(a.roll, std::f64::consts::FRAC_PI_2);
+    /// assert!(hil_kinova_mujoco::Action::from_label("XX0").is_err());
+    /// ```
+    pub fn from_label(name: &'static str) -> Result<Self, KinovaError> {
+        let unknown = || KinovaError::UnknownAction {
+            name: name.to_string(),
+        };
+        let (prefix, degrees) = name.split_at_checked(2).ok_or_else(unknown)?;
+        let family = PitchFamily::from_prefix(prefix).ok_or_else(unknown)?;
+        let roll = match degrees {
+            "0" => 0.0,
+            "90" => std::f64::consts::FRAC_PI_2,
+            _ => return Err(unknown()),
+        };
+        Ok(Self {
+            name,
+            family,
+            pitch: family.pitch(),
+            roll,
+            max_force: family.max_force(),
+            approach_tilt: family.approach_tilt(),
+        })
+    }
+}
+
+/// The six actions in the feeding task's arm order (VS0 VS90 TV0 TV90 TA0
+/// TA90), built from `hil_envs::feeding::action_space` so the simulator's
+/// arm `i` is the task's arm `i` by construction.
+///
+/// ```
+/// let names: Vec<_> = hil_kinova_mujoco::actions().iter().map(|a| a.name).collect();
+/// assert_eq!(names, hil_envs::feeding::FeedingTask::bundled().actions());
+/// ```
+pub fn actions() -> &'static [Action] {
+    static ACTIONS: OnceLock<Vec<Action>> = OnceLock::new();
+    ACTIONS.get_or_init(|| {
+        hil_envs::feeding::FeedingTask::bundled()
+            .actions()
+            .iter()
+            .map(|name| match Action::from_label(name) {
+                Ok(action) => action,
+                // The bundled table is compiled in; a test below reads it.
+                Err(e) => panic!("hil-envs' bundled feeding actions: {e}"),
+            })
+            .collect()
+    })
+}
 
 /// What turns the tine row by an action's roll.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -327,13 +391,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn every_bundled_action_label_decodes_in_arm_order() {
+        let task = hil_envs::feeding::FeedingTask::bundled();
+        let names: Vec<&str> = actions().iter().map(|a| a.name).collect();
+        assert_eq!(names, task.actions());
+        for bad in ["", "VS", "VS45", "XY0", "vs0"] {
+            assert!(matches!(
+                Action::from_label(bad),
+                Err(KinovaError::UnknownAction { .. })
+            ));
+        }
+    }
+
+    #[test]
     fn vs_and_tv_move_in_vertically_and_ta_two_down_for_one_across() {
-        for action in &ACTIONS {
+        for action in actions() {
             let u = tine_direction(&fork_base_orientation(0.3), action.pitch, action.roll);
             let dir = approach_direction(action, &u);
             assert!((dir.norm() - 1.0).abs() < 1e-12);
             let across = dir.x.hypot(dir.y);
-            if action.name.starts_with("TA") {
+            if action.family == PitchFamily::Ta {
                 // Vertical component twice the horizontal (fact sheet §3),
                 // towards the side the tines lean.
                 assert!(

@@ -27,7 +27,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::controller::{ACTIONS, RollBy};
+use crate::controller::{RollBy, actions};
 use crate::food::{FoodKind, FoodModel, FoodProps, Setting, parse_labels};
 use crate::model::MjcfSource;
 use crate::perception::{Embedding, Observation, PerceptionNoise, RIM_RADIUS, perceive};
@@ -264,9 +264,9 @@ pub fn simulated_pretraining(
             pretraining_trials: 0,
             ..cfg.clone()
         })?;
-        for arm in 0..ACTIONS.len() {
+        for arm in 0..actions().len() {
             for t in 0..cfg.pretraining_trials {
-                let stream = (food.index() * ACTIONS.len() + arm) * cfg.pretraining_trials + t;
+                let stream = (food.index() * actions().len() + arm) * cfg.pretraining_trials + t;
                 env.reset(hil_core::session::splitmix(
                     seed ^ PRETRAIN_STREAM,
                     stream as u64,
@@ -378,7 +378,7 @@ impl KinovaFeedingEnv {
         let obs = cur.observation.take().ok_or_else(|| {
             HilError::state("kinova_feeding", "execute called without a fresh observe")
         })?;
-        let report = self.sim.execute(&ACTIONS[arm.0], &obs.target, keyframe)?;
+        let report = self.sim.execute(&actions()[arm.0], &obs.target, keyframe)?;
         let success = report.success;
         self.last = Some(report);
         Ok(Outcome::new(success))

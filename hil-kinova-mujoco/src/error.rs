@@ -7,6 +7,15 @@ use hil_core::HilError;
 /// What can go wrong while loading or running the simulation.
 #[derive(Debug, thiserror::Error)]
 pub enum KinovaError {
+    /// An action label is not a pitch family (VS, TV, TA) followed by a
+    /// roll of 0 or 90 degrees.
+    #[error(
+        "action {name:?} is not a skewering action the simulator knows (VS, TV or TA followed by 0 or 90, e.g. TV90)"
+    )]
+    UnknownAction {
+        /// The label.
+        name: String,
+    },
     /// The MJCF file does not exist or cannot be read.
     #[error("MJCF file {}: {source}", path.display())]
     MjcfUnreadable {

@@ -15,7 +15,7 @@
 //!   ([`Placement`], [`PerceivedTarget`], [`AttemptReport`]), on our own
 //!   MJCF of the Gen3 6-DoF arm with the 2-DoF feeding fork or on a scene
 //!   given as [`MjcfSource`];
-//! - the six skewering actions ([`ACTIONS`]), food kinds and placement
+//! - the six skewering actions ([`actions`]), food kinds and placement
 //!   settings ([`FoodKind`], [`Setting`]);
 //! - [`KeyframeWriter`] / [`RenderingEnv`]: PNG keyframes of attempts.
 //!
@@ -61,11 +61,11 @@ pub use attempt_log::AttemptLog;
 #[cfg(feature = "physics")]
 pub use calibrate::{
     AttemptRecord, CalibrationOptions, CalibrationOverSeeds, CalibrationReport, CalibrationRow,
-    CalibrationTarget, Consistency, SettingCell, TARGET_GRID, calibrate, calibrate_over_seeds,
-    calibrate_with, expected_abs_error_of_a_perfect_simulator,
+    CalibrationTarget, Consistency, SettingCell, TARGET_GRID, Tally, calibrate,
+    calibrate_over_seeds, calibrate_with, expected_abs_error_of_a_perfect_simulator,
 };
 #[cfg(feature = "physics")]
-pub use controller::{ACTIONS, Action, RollBy};
+pub use controller::{Action, PitchFamily, RollBy, actions};
 #[cfg(feature = "physics")]
 pub use env::{
     KinovaFeedingConfig, KinovaFeedingEnv, MAX_CONTEXT_DIM, MAX_PRETRAINING_TRIALS,

@@ -350,23 +350,29 @@ fn print_table(rows: &[CalibrationRow]) {
     for chunk in rows.chunks(6) {
         print!("{:<22}", chunk[0].food);
         for r in chunk {
-            print!("{:>18}", cell(r.rate, r.se, r.published, r.p_value));
+            print!(
+                "{:>18}",
+                cell(r.counts.rate, r.counts.se, r.published, r.p_value)
+            );
         }
         println!();
         for (i, c) in chunk[0].by_setting.iter().enumerate() {
             print!("{:<22}", format!("  {}", c.setting.name()));
             for r in chunk {
                 let c = &r.by_setting[i];
-                print!("{:>18}", cell(c.rate, c.se, c.published, c.p_value));
+                print!(
+                    "{:>18}",
+                    cell(c.counts.rate, c.counts.se, c.published, c.p_value)
+                );
             }
             println!();
         }
     }
     println!("* p < 0.05: a difference from the published rate that chance alone explains poorly");
-    let discarded: usize = rows.iter().map(|r| r.discarded).sum();
+    let discarded: usize = rows.iter().map(|r| r.counts.discarded).sum();
     println!(
         "{discarded} of {} attempts discarded (fewer than {} tines touched the item, as in the published data set); rates are over the rest",
-        rows.iter().map(|r| r.trials).sum::<usize>(),
+        rows.iter().map(|r| r.counts.trials).sum::<usize>(),
         hil_kinova_mujoco::MIN_TINES_TOUCHED
     );
 }

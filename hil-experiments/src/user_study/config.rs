@@ -4,13 +4,10 @@
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
-use hil_config::{
-    BuildContext, EnvironmentConfig, QueryChannelConfig, WorkloadModelConfig, parse_toml,
-};
+use hil_config::{BuildContext, EnvironmentConfig, QueryChannelConfig, WorkloadModelConfig};
 use hil_core::{ConfigError, HilError, Result, SessionSettings};
 use hil_paper::user_study as paper_study;
 
-use crate::load_plugins;
 use crate::method::Method;
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -239,8 +236,7 @@ impl UserStudyConfig {
 
     /// Reads and validates a study file (see [`UserStudyConfig::parse`]).
     pub fn load(path: &Path) -> Result<Self> {
-        let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
-        Ok(Self::parse(&text, path)?)
+        crate::experiment_config::read_config_file(path, Self::parse)
     }
 
     /// Parses and validates study TOML; `path` names the file in errors and
@@ -250,8 +246,7 @@ impl UserStudyConfig {
     /// the `physics` feature refuses a file that names no `[environment]`,
     /// since the paper's scene is the MuJoCo simulation.
     pub fn parse(text: &str, path: &Path) -> std::result::Result<Self, ConfigError> {
-        load_plugins(text, path)?;
-        let cfg: Self = parse_toml(text, path)?;
+        let cfg: Self = crate::experiment_config::parse_listing_plugins(text, path)?;
         cfg.validate_in(text, path)?;
         if !hil_kinova_mujoco::PHYSICS && !names_environment(text) {
             return Err(hil_config::error_at_key(

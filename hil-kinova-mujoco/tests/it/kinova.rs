@@ -12,8 +12,8 @@ use hil_core::{
     SessionSettings,
 };
 use hil_kinova_mujoco::{
-    ACTIONS, FoodKind, FoodModel, KinovaError, KinovaFeedingConfig, KinovaFeedingEnv, MjcfSource,
-    Placement, Simulator,
+    FoodKind, FoodModel, KinovaError, KinovaFeedingConfig, KinovaFeedingEnv, MjcfSource, Placement,
+    Simulator, actions,
 };
 use nalgebra::Vector3;
 use rand::SeedableRng;
@@ -76,7 +76,7 @@ fn forward_kinematics_matches_the_fact_sheet() {
 fn every_action_reaches_its_commanded_pitch_and_roll() {
     let mut sim = Simulator::new().unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
-    for (i, action) in ACTIONS.iter().enumerate() {
+    for (i, action) in actions().iter().enumerate() {
         let props = FoodModel::default_for(FoodKind::Cantaloupe).sample(&mut rng);
         let yaw = -1.0 + 0.4 * i as f64;
         let items = vec![Placement {
@@ -295,7 +295,7 @@ fn calibration_does_not_depend_on_the_number_of_threads() {
     assert!(
         rows1
             .iter()
-            .all(|r| r.by_setting.iter().all(|c| c.trials == 1))
+            .all(|r| r.by_setting.iter().all(|c| c.counts.trials == 1))
     );
     assert_eq!(rows1[4].published, Some(0.57)); // TA0, setting `all`
 }

@@ -3,7 +3,7 @@
 //! pitch β and roll γ through the fork's joints while the arm holds the
 //! handle's orientation.
 
-use hil_kinova_mujoco::{ACTIONS, Action, FoodKind, KinovaError, RollBy, Simulator, StopReason};
+use hil_kinova_mujoco::{Action, FoodKind, KinovaError, RollBy, Simulator, StopReason, actions};
 
 use hil_paper::food_data::HOLD_SECONDS;
 
@@ -41,7 +41,7 @@ fn skewered_items_stay_on_the_fork_through_the_5_s_hold() {
     ];
     let mut lifted = 0;
     for (kind, name) in cases {
-        let action = ACTIONS.iter().find(|a| a.name == name).unwrap();
+        let action = actions().iter().find(|a| a.name == name).unwrap();
         for seed in 0..6 {
             let r = attempt(&mut sim, kind, action, seed);
             // Items lifted on at least two tines, none torn out: an item
@@ -71,7 +71,7 @@ fn skewered_items_stay_on_the_fork_through_the_5_s_hold() {
 #[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn each_action_rolls_by_the_forks_gamma_while_the_arm_holds_the_handle() {
     let mut sim = Simulator::new().unwrap();
-    for (i, action) in ACTIONS.iter().enumerate() {
+    for (i, action) in actions().iter().enumerate() {
         let r = attempt(&mut sim, FoodKind::Cantaloupe, action, i as u64);
         assert_reached(action, "β", r.reached_pitch, action.pitch, 0.03);
         // The roll is made by the fork's γ joint ...
@@ -97,7 +97,7 @@ fn the_data_sets_rigid_fork_reaches_tvs_force_where_the_2_dof_forks_servos_yield
     // The published data set's fork (no joints) stops at TV's 20 N; the
     // study fork's pitch servo (0.93 N·m) yields under the off-axis push,
     // the tines swing and drag the slice across the plate.
-    let tv0 = ACTIONS.iter().find(|a| a.name == "TV0").unwrap();
+    let tv0 = actions().iter().find(|a| a.name == "TV0").unwrap();
     let run = |roll_by: RollBy| {
         let mut sim = Simulator::new().unwrap();
         sim.set_roll_by(roll_by);

@@ -4,14 +4,14 @@
 
 use crate::common::attempt_at;
 use hil_kinova_mujoco::{
-    ACTIONS, AttemptReport, FREE_DT, FoodKind, KinovaError, MAX_DT, REF_DT, Simulator,
+    AttemptReport, FREE_DT, FoodKind, KinovaError, MAX_DT, REF_DT, Simulator, actions,
 };
 
 fn attempt(sim: &mut Simulator, kind: FoodKind, action: usize, seed: u64) -> AttemptReport {
     attempt_at(
         sim,
         kind,
-        &ACTIONS[action],
+        &actions()[action],
         seed,
         [0.0, 0.0],
         0.4 * seed as f64,
@@ -36,7 +36,7 @@ fn the_long_free_step_keeps_the_outcomes_of_the_1_ms_step() {
         for seed in 0..3 {
             let a = attempt(&mut exact, kind, action, seed);
             let b = attempt(&mut fast, kind, action, seed);
-            let what = format!("{} {} seed {seed}", kind.name(), ACTIONS[action].name);
+            let what = format!("{} {} seed {seed}", kind.name(), actions()[action].name);
             assert_eq!(a.success, b.success, "{what}: {a:?} vs {b:?}");
             assert!(
                 (a.final_height - b.final_height).abs() < 0.002,

@@ -2,6 +2,7 @@
 //! link instead of one per file); each module was a file of its own.
 
 mod checkpoint_unsupported;
+mod choices;
 mod properties;
 mod session_loop;
 mod session_step;

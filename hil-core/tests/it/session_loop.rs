@@ -7,7 +7,7 @@ use hil_core::channel::PerfectExpert;
 use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::{
     ActionSpace, Answer, ArmId, Choice, EpisodeReport, EventCollector, Query, QueryChannel,
-    QueryKind, Response, Session, SessionObserver, SessionSettings, StepDecision,
+    Response, Session, SessionObserver, SessionSettings, StepDecision,
 };
 
 fn actions() -> ActionSpace {
@@ -35,16 +35,7 @@ fn episode(
     .unwrap()
 }
 
-fn act(a: usize) -> Choice {
-    Choice::Act { arm: ArmId(a) }
-}
-
-fn query(fallback: usize) -> Choice {
-    Choice::Query {
-        kind: QueryKind::default(),
-        fallback: ArmId(fallback),
-    }
-}
+use crate::choices::{act, query};
 
 /// The hand-worked episode (N_att = 3, WL_0 = 0.5, +0.1 per query):
 ///

@@ -13,19 +13,10 @@ use hil_core::channel::PerfectExpert;
 use hil_core::record::{Header, RecordLog, Recorder};
 use hil_core::{
     ActionSpace, ArmId, Choice, Decision, Episode, EpisodeReport, EventCollector, HilError, Policy,
-    QueryKind, Session, SessionObserver, SessionSettings,
+    Session, SessionObserver, SessionSettings,
 };
 
-fn act(a: usize) -> Choice {
-    Choice::Act { arm: ArmId(a) }
-}
-
-fn query(fallback: usize) -> Choice {
-    Choice::Query {
-        kind: QueryKind::default(),
-        fallback: ArmId(fallback),
-    }
-}
+use crate::choices::{act, query};
 
 /// Acts, asks (the expert's arm then repeats) and fails items out: every
 /// path through an item.
@@ -215,6 +206,14 @@ fn with_session(f: impl FnOnce(&mut Session<'_>)) {
 
 /// Finishes `episode` by its session's own policy and checks it is the
 /// uninterrupted episode.
+/// Feeds the policy's answer to the awaited decision, then finishes as
+/// [`finish_normally`] does: the episode recovered from a refused call.
+fn answer_pending_and_finish(session: &mut Session<'_>, episode: &mut Episode) {
+    let decision = session.policy.decide(&episode.pending().unwrap()).unwrap();
+    session.feed_decision(episode, decision, &mut []).unwrap();
+    finish_normally(session, episode);
+}
+
 fn finish_normally(session: &mut Session<'_>, episode: &mut Episode) {
     while session.step(episode, &mut []).unwrap() {}
     let report = session.finish_episode(episode, &mut []).unwrap();
@@ -275,11 +274,7 @@ fn asking_again_while_a_decision_is_awaited_is_a_state_error() {
         );
         // The awaited decision is still the same one.
         assert_eq!(episode.pending().unwrap().t, t);
-        let decision = session.policy.decide(&episode.pending().unwrap()).unwrap();
-        session
-            .feed_decision(&mut episode, decision, &mut [])
-            .unwrap();
-        finish_normally(session, &mut episode);
+        answer_pending_and_finish(session, &mut episode);
     });
 }
 
@@ -296,11 +291,7 @@ fn finishing_before_the_last_item_is_a_state_error() {
             session.finish_episode(&mut episode, &mut []).unwrap_err(),
             "finish_episode",
         );
-        let decision = session.policy.decide(&episode.pending().unwrap()).unwrap();
-        session
-            .feed_decision(&mut episode, decision, &mut [])
-            .unwrap();
-        finish_normally(session, &mut episode);
+        answer_pending_and_finish(session, &mut episode);
     });
 }
 

@@ -162,7 +162,7 @@ impl Site {
 pub fn refuse_foreign_post(req: &Request) -> Option<Response> {
     let host = req.header("host").unwrap_or("");
     match req.header("origin") {
-        Some(o) if o.eq_ignore_ascii_case(&format!("http://{host}")) => {}
+        Some(o) if o.eq_ignore_ascii_case(&format!("{}://{host}", req.scheme.as_str())) => {}
         Some(_) => {
             return Some(forbidden(
                 "answers are accepted only from the page's own origin",

@@ -10,10 +10,15 @@
 //! - [`guard`]: the checks every page request passes — the per-session
 //!   token in the path, the `Host` header (against DNS rebinding), and that
 //!   a POST comes from the page's own origin with a JSON body.
-//! - [`page`]: serving a page's files: the shared style sheet and
+//! - [`page`]: serving a page's files: the top every page shares (head,
+//!   header, switch-scanning settings), the shared style sheet and
 //!   single-switch scanning script, compiled-in assets, and item pictures
 //!   from a folder.
+//! - [`tls`]: HTTPS ([`Server::start_tls`]) with the lab's certificate or
+//!   a self-signed one kept in the data folder, and its fingerprint.
 //! - [`urls`]: the URLs to print for the address the server is bound to.
+//! - [`secrets`]: tokens and keys kept between runs in files only their
+//!   owner may read.
 //! - `testing` (feature `testing`): a raw HTTP client and a headless
 //!   Chromium driver for the pages' test suites.
 //!
@@ -22,11 +27,11 @@
 //!
 //! ## The server's limits
 //!
-//! Limits (answered with the status code in brackets): request head
-//! 16 KiB [431], request target 2 KiB [414], body 16 KiB [413], a body
-//! without `Content-Length` [411], chunked bodies [501], a malformed request
-//! [400], a whole request not received within 10 s of connecting [408]
-//! (however steadily it trickles in).
+//! Limits (answered with the status code in parentheses): request head
+//! 16 KiB (431), request target 2 KiB (414), body 16 KiB (413), a body
+//! without `Content-Length` (411), chunked bodies (501), a malformed request
+//! (400), a whole request not received within 10 s of connecting (408)
+//! (however steadily it trickles in; over HTTPS the handshake counts too).
 //!
 //! Connections ([`Limits`]): 64 for clients that have not shown the
 //! session's token (when all are taken, a newcomer takes the oldest one's
@@ -41,10 +46,12 @@ use std::time::Duration;
 pub mod guard;
 pub mod page;
 pub mod parse;
+pub mod secrets;
 mod server;
 mod slots;
 #[cfg(feature = "testing")]
 pub mod testing;
+pub mod tls;
 pub mod urls;
 
 pub use server::Server;
@@ -94,9 +101,31 @@ pub trait Service: Send + Sync + 'static {
     fn handle(&self, req: &Request) -> Response;
 }
 
+/// How a request arrived.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Scheme {
+    /// Plain HTTP (loopback).
+    #[default]
+    Http,
+    /// HTTPS ([`Server::start_tls`]).
+    Https,
+}
+
+impl Scheme {
+    /// `http` or `https`, as in a URL.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Http => "http",
+            Self::Https => "https",
+        }
+    }
+}
+
 /// A parsed request.
 #[derive(Debug, Clone)]
 pub struct Request {
+    /// Whether it came over plain HTTP or HTTPS.
+    pub scheme: Scheme,
     /// `GET`, `POST`, ...
     pub method: String,
     /// The path, without the query string.

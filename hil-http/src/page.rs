@@ -20,19 +20,84 @@ pub const SCAN_JS: &str = include_str!("../assets/scan.js");
 /// and the step interval, for a page's header.
 const SCAN_SETTINGS_HTML: &str = include_str!("../assets/scan-settings.html");
 
-/// The line a page's HTML holds where the scanning settings go.
-const SCAN_SETTINGS_MARK: &str = "  <!-- scan settings -->\n";
+/// The top every page shares, from `<!DOCTYPE html>` to the end of its
+/// header: the head (charset, viewport, no referrer, [`PAGE_CSS`] then the
+/// page's sheets, [`SCAN_JS`] then its scripts), a skip link, the heading
+/// and the switch-scanning settings.
+const PAGE_TOP_HTML: &str = include_str!("../assets/page-top.html");
 
-/// A page's HTML with the switch-scanning settings put in at its
-/// `<!-- scan settings -->` line (a page without one is returned as it
-/// is), so that every page offers the same settings.
+/// The page's own values in its first line:
+/// `<!-- page title="…" heading="…" skip="…" skip_label="…" styles="…" scripts="…" -->`.
+const PAGE_FIELDS: [&str; 6] = [
+    "title",
+    "heading",
+    "skip",
+    "skip_label",
+    "styles",
+    "scripts",
+];
+
+/// A page's HTML with the shared top (`assets/page-top.html`) in place of its
+/// first line, which names the page's title, heading, skip-link target and
+/// label, and its own style sheets and scripts (space-separated, after
+/// `app.css` and `scan.js`). So every page has the same head, header and
+/// switch-scanning settings. A page without that line is returned as it is.
 ///
 /// ```
-/// let page = hil_http::page::with_scan_settings("<header>\n  <!-- scan settings -->\n</header>\n");
-/// assert!(page.contains(r#"id="scan-toggle""#) && page.contains(r#"id="scan-speed""#));
+/// let page = hil_http::page::assemble(
+///     "<!-- page title=\"T\" heading=\"H\" skip=\"main\" skip_label=\"Skip\" styles=\"a.css\" scripts=\"a.js\" -->\n<main id=\"main\"></main>\n",
+/// );
+/// assert!(page.starts_with("<!DOCTYPE html>"));
+/// assert!(page.contains("<title>T</title>") && page.contains(r#"<h1 id="title">H</h1>"#));
+/// assert!(page.contains(r#"<link rel="stylesheet" href="a.css">"#));
+/// assert!(page.contains(r#"<script src="a.js" defer></script>"#));
+/// assert!(page.contains(r#"id="scan-toggle""#) && page.ends_with("<main id=\"main\"></main>\n"));
 /// ```
-pub fn with_scan_settings(html: &str) -> String {
-    html.replacen(SCAN_SETTINGS_MARK, SCAN_SETTINGS_HTML, 1)
+pub fn assemble(html: &str) -> String {
+    let (first, rest) = html.split_once('\n').unwrap_or((html, ""));
+    let Some(fields) = first
+        .trim()
+        .strip_prefix("<!-- page ")
+        .and_then(|f| f.strip_suffix("-->"))
+        .and_then(page_fields)
+    else {
+        return html.to_string();
+    };
+    let tags = |list: &str, tag: fn(&str) -> String| -> String {
+        list.split_whitespace().map(tag).collect()
+    };
+    let styles = tags(&fields[4], |s| {
+        format!("<link rel=\"stylesheet\" href=\"{s}\">\n")
+    });
+    let scripts = tags(&fields[5], |s| {
+        format!("<script src=\"{s}\" defer></script>\n")
+    });
+    let top = PAGE_TOP_HTML
+        .replace("{title}", &fields[0])
+        .replace("{heading}", &fields[1])
+        .replace("{skip}", &fields[2])
+        .replace("{skip_label}", &fields[3])
+        .replace("{styles}", &styles)
+        .replace("{scripts}", &scripts)
+        .replace("{scan_settings}", SCAN_SETTINGS_HTML);
+    top + rest
+}
+
+/// The [`PAGE_FIELDS`] of `key="value" …`, in that order; `None` unless
+/// each is given once and nothing else is.
+fn page_fields(text: &str) -> Option<Vec<String>> {
+    let mut found: Vec<Option<String>> = vec![None; PAGE_FIELDS.len()];
+    let mut rest = text.trim();
+    while !rest.is_empty() {
+        let (key, after) = rest.split_once("=\"")?;
+        let (value, after) = after.split_once('"')?;
+        let i = PAGE_FIELDS.iter().position(|k| *k == key.trim())?;
+        if found[i].replace(value.to_string()).is_some() {
+            return None;
+        }
+        rest = after.trim_start();
+    }
+    found.into_iter().collect()
 }
 
 /// Content type of an HTML page.

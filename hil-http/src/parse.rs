@@ -182,6 +182,8 @@ impl RequestParser {
             return Progress::NeedMore;
         }
         Progress::Complete(Request {
+            // The server sets it (the parser sees only bytes).
+            scheme: crate::Scheme::Http,
             method: line.method.clone(),
             path: line.path.clone(),
             headers: std::mem::take(&mut head.headers),

@@ -1,5 +1,5 @@
 //! The accept loop and one thread per connection: read one request under a
-//! deadline, answer it, close.
+//! deadline, answer it, close; over plain TCP or TLS.
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -10,7 +10,8 @@ use std::time::{Duration, Instant};
 
 use super::parse::{Progress, RequestParser};
 use super::slots::{Occupancy, Slots, Ticket};
-use super::{Limits, Request, Response, Service};
+use super::tls::Tls;
+use super::{Limits, Request, Response, Scheme, Service};
 
 /// How long a client may take to read a response before it is dropped.
 const WRITE_TIMEOUT: Duration = Duration::from_secs(10);
@@ -44,6 +45,26 @@ impl Server {
         service: Arc<dyn Service>,
         limits: Limits,
     ) -> std::io::Result<Self> {
+        Self::start_with(addr, service, limits, None)
+    }
+
+    /// As [`start`](Self::start), over HTTPS with `tls`: the same limits,
+    /// the request deadline covering the TLS handshake too.
+    pub fn start_tls(
+        addr: SocketAddr,
+        service: Arc<dyn Service>,
+        limits: Limits,
+        tls: &Tls,
+    ) -> std::io::Result<Self> {
+        Self::start_with(addr, service, limits, Some(tls.config()))
+    }
+
+    fn start_with(
+        addr: SocketAddr,
+        service: Arc<dyn Service>,
+        limits: Limits,
+        tls: Option<Arc<rustls::ServerConfig>>,
+    ) -> std::io::Result<Self> {
         if limits.open_slots == 0 || limits.trusted_slots == 0 || limits.request_deadline.is_zero()
         {
             return Err(std::io::Error::new(
@@ -71,12 +92,28 @@ impl Server {
                         continue;
                     };
                     let service = service.clone();
+                    let tls = tls.clone();
                     // If the thread cannot start, the closure (stream and
                     // ticket) is dropped: the connection closes, the slot
                     // is given back.
                     let _ = std::thread::Builder::new()
                         .name("hil-web-conn".into())
-                        .spawn(move || serve(stream, ticket, deadline, service.as_ref()));
+                        .spawn(move || {
+                            let socket = Socket {
+                                tcp: stream,
+                                deadline,
+                            };
+                            let conn = match tls {
+                                None => Conn::Plain(socket),
+                                Some(config) => match rustls::ServerConnection::new(config) {
+                                    Ok(c) => {
+                                        Conn::Tls(Box::new(rustls::StreamOwned::new(c, socket)))
+                                    }
+                                    Err(_) => return,
+                                },
+                            };
+                            serve(conn, ticket, service.as_ref())
+                        });
                 }
             })?;
         Ok(Self {
@@ -122,21 +159,121 @@ fn refuse_busy(mut stream: TcpStream) {
     let _ = write_response(&mut stream, &Response::text(503, "busy"));
 }
 
-fn serve(mut stream: TcpStream, mut ticket: Ticket, deadline: Instant, service: &dyn Service) {
-    let _ = stream.set_write_timeout(Some(WRITE_TIMEOUT));
-    let response = match read_request(&mut stream, &mut ticket, deadline, service) {
+/// A connection's socket: every read must end by `deadline` (set before
+/// each read of the socket, so a TLS handshake that trickles in cannot
+/// outlast it either).
+struct Socket {
+    tcp: TcpStream,
+    deadline: Instant,
+}
+
+impl Read for Socket {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let left = self.deadline.saturating_duration_since(Instant::now());
+        // A zero timeout would mean "none" to the socket.
+        if left.is_zero() {
+            return Err(std::io::ErrorKind::TimedOut.into());
+        }
+        self.tcp.set_read_timeout(Some(left))?;
+        self.tcp.read(buf)
+    }
+}
+
+impl Write for Socket {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.tcp.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.tcp.flush()
+    }
+}
+
+/// One client's connection, plain or TLS.
+enum Conn {
+    Plain(Socket),
+    Tls(Box<rustls::StreamOwned<rustls::ServerConnection, Socket>>),
+}
+
+impl Conn {
+    fn socket(&mut self) -> &mut Socket {
+        match self {
+            Self::Plain(s) => s,
+            Self::Tls(t) => &mut t.sock,
+        }
+    }
+
+    fn handshaking(&self) -> bool {
+        matches!(self, Self::Tls(t) if t.conn.is_handshaking())
+    }
+
+    fn scheme(&self) -> Scheme {
+        match self {
+            Self::Plain(_) => Scheme::Http,
+            Self::Tls(_) => Scheme::Https,
+        }
+    }
+
+    /// Ends the response: TLS's close_notify, then no more writing.
+    fn finish(&mut self) {
+        if let Self::Tls(t) = self {
+            t.conn.send_close_notify();
+            while t.conn.wants_write() {
+                match t.conn.write_tls(&mut t.sock) {
+                    Ok(n) if n > 0 => {}
+                    _ => break,
+                }
+            }
+        }
+        let _ = self.flush();
+        let _ = self.socket().tcp.shutdown(std::net::Shutdown::Write);
+    }
+}
+
+impl Read for Conn {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match self {
+            Self::Plain(s) => s.read(buf),
+            Self::Tls(t) => t.read(buf),
+        }
+    }
+}
+
+impl Write for Conn {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        match self {
+            Self::Plain(s) => s.write(buf),
+            Self::Tls(t) => t.write(buf),
+        }
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        match self {
+            Self::Plain(s) => s.flush(),
+            Self::Tls(t) => t.flush(),
+        }
+    }
+}
+
+fn serve(mut conn: Conn, mut ticket: Ticket, service: &dyn Service) {
+    let _ = conn.socket().tcp.set_write_timeout(Some(WRITE_TIMEOUT));
+    let response = match read_request(&mut conn, &mut ticket, service) {
         Ok(req) => {
             // A handler bug must not take the server down.
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| service.handle(&req)))
                 .unwrap_or_else(|_| Response::text(500, "internal error"))
         }
+        // Before the TLS handshake is done there is no channel to answer
+        // on (and writing would go on with the handshake): just close.
+        Err(Some(_)) if conn.handshaking() => return,
         Err(Some(r)) => r,
         Err(None) => return, // the client went away, or was evicted
     };
-    let _ = write_response(&mut stream, &response);
-    let _ = stream.flush();
-    let _ = stream.shutdown(std::net::Shutdown::Write);
-    drain(&mut stream);
+    // Writing TLS may read (a key update): give it time of its own.
+    conn.socket().deadline = Instant::now() + WRITE_TIMEOUT;
+    let _ = write_response(&mut conn, &response);
+    conn.finish();
+    drain(&mut conn.socket().tcp);
 }
 
 /// Reads what the client still sends, within [`DRAIN_TIME`] and
@@ -157,26 +294,20 @@ fn drain(stream: &mut TcpStream) {
     }
 }
 
-/// Reads one request by `deadline`; moves the connection to the trusted
-/// pool as soon as its request line shows that the client may be served
-/// there. `Err(Some(response))` for a request to refuse, `Err(None)` when
-/// the client vanished.
+/// Reads one request by the socket's deadline; moves the connection to
+/// the trusted pool as soon as its request line shows that the client may
+/// be served there. `Err(Some(response))` for a request to refuse,
+/// `Err(None)` when the client vanished (or its TLS failed).
 fn read_request(
-    stream: &mut TcpStream,
+    conn: &mut Conn,
     ticket: &mut Ticket,
-    deadline: Instant,
     service: &dyn Service,
 ) -> Result<Request, Option<Response>> {
     let mut parser = RequestParser::default();
     let mut chunk = [0u8; 2048];
     let mut placed = false;
     loop {
-        let left = deadline.saturating_duration_since(Instant::now());
-        // A zero timeout would mean "none" to the socket.
-        if left.is_zero() || stream.set_read_timeout(Some(left)).is_err() {
-            return Err(Some(Response::text(408, "too slow")));
-        }
-        let progress = match stream.read(&mut chunk) {
+        let progress = match conn.read(&mut chunk) {
             Ok(0) => return Err(parser.end_of_input().map(Response::from)),
             Ok(n) => parser.push(&chunk[..n]),
             Err(e) if is_timeout(&e) => return Err(Some(Response::text(408, "too slow"))),
@@ -190,13 +321,16 @@ fn read_request(
         }
         match progress {
             Ok(Progress::NeedMore) => {}
-            Ok(Progress::Complete(req)) => return Ok(req),
+            Ok(Progress::Complete(mut req)) => {
+                req.scheme = conn.scheme();
+                return Ok(req);
+            }
             Err(refusal) => return Err(Some(refusal.into())),
         }
     }
 }
 
-fn write_response(stream: &mut TcpStream, r: &Response) -> std::io::Result<()> {
+fn write_response(stream: &mut impl Write, r: &Response) -> std::io::Result<()> {
     let head = format!(
         "HTTP/1.1 {} {}\r\nContent-Type: {}\r\nContent-Length: {}\r\nConnection: close\r\n\
          Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n\

@@ -4,6 +4,8 @@
 
 use std::net::{IpAddr, SocketAddr};
 
+use crate::Scheme;
+
 /// The hosts at which a server bound to `bound` is reached, those other
 /// machines can use first:
 ///
@@ -70,9 +72,21 @@ fn hosts_for_unspecified(bound: IpAddr, addrs: impl Iterator<Item = IpAddr>) -> 
 /// assert_eq!(page_url(v6, 8765, "abc"), "http://[::1]:8765/abc/");
 /// ```
 pub fn page_url(host: IpAddr, port: u16, token: &str) -> String {
+    page_url_over(Scheme::Http, host, port, token)
+}
+
+/// The page's URL at `host`, over `scheme`.
+///
+/// ```
+/// use hil_http::{Scheme, urls::page_url_over};
+/// let ip = "127.0.0.1".parse().unwrap();
+/// assert_eq!(page_url_over(Scheme::Https, ip, 8765, "abc"), "https://127.0.0.1:8765/abc/");
+/// ```
+pub fn page_url_over(scheme: Scheme, host: IpAddr, port: u16, token: &str) -> String {
+    let scheme = scheme.as_str();
     match host {
-        IpAddr::V4(ip) => format!("http://{ip}:{port}/{token}/"),
-        IpAddr::V6(ip) => format!("http://[{ip}]:{port}/{token}/"),
+        IpAddr::V4(ip) => format!("{scheme}://{ip}:{port}/{token}/"),
+        IpAddr::V6(ip) => format!("{scheme}://[{ip}]:{port}/{token}/"),
     }
 }
 

@@ -22,14 +22,22 @@ pub enum Order {
     Fixed,
 }
 
-/// Where the baseline conditions (distraction only) come.
+/// Where the baseline conditions (distraction only) come. The paper lists
+/// its two baselines but does not say where in the session they came or
+/// in which order; `first` is hil's choice.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BaselinePosition {
-    /// Before the first robot query: a resting workload (the default).
+    /// Before the first robot query, in the listed order: a workload
+    /// measured before any query (the default).
     First,
-    /// After the last query condition.
+    /// After the last query condition, in the listed order.
     Last,
+    /// Counterbalanced: every other participant takes them first, the
+    /// others last, and their order among themselves rotates every two
+    /// participants (so with two baselines, each of first/last × both
+    /// orders once in every four participants).
+    Counterbalanced,
 }
 
 /// The study design; the defaults are the paper's.
@@ -103,6 +111,31 @@ pub struct ServerConfig {
     /// Real seconds without a request from the participant's page after
     /// which they count as away: the task clock does not run while away.
     pub away_after_s: f64,
+    /// Serve HTTPS on loopback too. Beyond loopback (`--lan`) the pages
+    /// are always served over HTTPS: plain HTTP would carry the
+    /// participants' tokens across the lab's network in clear.
+    pub https: bool,
+    /// The lab's certificate chain (PEM), with [`tls_key`](Self::tls_key);
+    /// relative to the config. Without them, HTTPS uses a self-signed
+    /// certificate made in the data folder at the first start.
+    pub tls_cert: Option<PathBuf>,
+    /// The private key of [`tls_cert`](Self::tls_cert) (PEM).
+    pub tls_key: Option<PathBuf>,
+}
+
+impl ServerConfig {
+    /// Whether the pages are served over HTTPS: beyond loopback always,
+    /// on loopback when asked (`https`, or a certificate given).
+    ///
+    /// ```
+    /// let mut s = hil_study::ServerConfig::default();
+    /// assert!(!s.uses_https());                  // loopback: plain HTTP
+    /// s.bind = "0.0.0.0".parse().unwrap();
+    /// assert!(s.uses_https());                   // a tablet on the LAN: HTTPS
+    /// ```
+    pub fn uses_https(&self) -> bool {
+        !self.bind.is_loopback() || self.https || self.tls_cert.is_some()
+    }
 }
 
 impl Default for ServerConfig {
@@ -112,6 +145,9 @@ impl Default for ServerConfig {
             port: 0,
             allowed_hosts: Vec::new(),
             away_after_s: 3.0,
+            https: false,
+            tls_cert: None,
+            tls_key: None,
         }
     }
 }
@@ -141,24 +177,9 @@ impl Default for MaterialsConfig {
     }
 }
 
-/// The whole study config (`hil study serve --config study.toml`):
-///
-/// ```toml
-/// [design]
-/// condition_min = 5.5                        # the defaults are the paper's design
-/// difficulties = ["easy", "hard"]
-/// distractions = ["none", "easy", "hard"]    # none, addition, transcription
-/// intervals_min = [1, 2]
-/// baselines = ["easy", "hard"]               # distraction-only conditions
-/// order = "balanced_latin_square"
-/// time_scale = 1.0                           # 60: a study minute lasts a second
-///
-/// [server]
-/// bind = "127.0.0.1"                         # "0.0.0.0" for a tablet on the LAN
-///
-/// [materials]
-/// dir = "materials"                          # optional: passage.txt, images/
-/// ```
+/// The whole study config (`hil study serve --config study.toml`); every
+/// key with its default is [`EXAMPLE_TOML`] (also in `hil study serve
+/// --help` and the crate's README).
 ///
 /// ```
 /// let c = hil_study::StudyConfig::parse("[design]\ntime_scale = 60\n", "s.toml".as_ref()).unwrap();
@@ -177,20 +198,32 @@ pub struct StudyConfig {
     pub materials: MaterialsConfig,
 }
 
+/// Every key of the study config with its default and what it does: shown
+/// by `hil study serve --help` and in the README (tests keep the three
+/// and the structs' fields the same).
+pub const EXAMPLE_TOML: &str = include_str!("../assets/study.toml");
+
 /// The most conditions (and baselines) a design may have.
 pub const MAX_CONDITIONS: usize = 64;
 
 impl StudyConfig {
-    /// Reads, parses and validates a config file; a relative
-    /// `materials.dir` is resolved against the file's folder.
+    /// Reads, parses and validates a config file; relative paths
+    /// (`materials.dir`, `server.tls_cert`, `server.tls_key`) are resolved
+    /// against the file's folder.
     pub fn load(path: &Path) -> Result<Self> {
         let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
         let mut c = Self::parse(&text, path)?;
-        if let Some(dir) = &c.materials.dir
-            && dir.is_relative()
-        {
-            let base = path.parent().unwrap_or(Path::new("."));
-            c.materials.dir = Some(base.join(dir));
+        let base = path.parent().unwrap_or(Path::new("."));
+        for file in [
+            &mut c.materials.dir,
+            &mut c.server.tls_cert,
+            &mut c.server.tls_key,
+        ] {
+            if let Some(p) = file
+                && p.is_relative()
+            {
+                *p = base.join(&*p);
+            }
         }
         Ok(c)
     }
@@ -313,10 +346,24 @@ impl DesignConfig {
 }
 
 impl ServerConfig {
-    /// Checks the host names and the away time.
+    /// Checks the host names, the away time, and that a certificate comes
+    /// with its key.
     pub fn validate(&self) -> Result<()> {
         hil_http::guard::check_allowed_hosts(&self.allowed_hosts)?;
-        check_seconds("away_after_s", self.away_after_s)
+        check_seconds("away_after_s", self.away_after_s)?;
+        match (&self.tls_cert, &self.tls_key) {
+            (Some(_), None) => Err(HilError::invalid_parameter(
+                "tls_cert",
+                "set",
+                "needs tls_key, the certificate's private key",
+            )),
+            (None, Some(_)) => Err(HilError::invalid_parameter(
+                "tls_key",
+                "set",
+                "needs tls_cert, the certificate it belongs to",
+            )),
+            _ => Ok(()),
+        }
     }
 }
 
@@ -339,5 +386,55 @@ impl MaterialsConfig {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The keys [`EXAMPLE_TOML`] shows in `[section]`, set or commented out.
+    fn shown_keys(section: &str) -> Vec<String> {
+        let mut keys = Vec::new();
+        let mut current = "";
+        for line in EXAMPLE_TOML.lines() {
+            let line = line.trim();
+            if let Some(name) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+                current = name;
+            } else if current == section
+                && let Some((key, _)) = line.trim_start_matches("# ").split_once(" = ")
+                && key.bytes().all(|b| b.is_ascii_lowercase() || b == b'_')
+            {
+                keys.push(key.to_string());
+            }
+        }
+        keys.sort();
+        keys
+    }
+
+    /// The example names every field of every section, no other, and its
+    /// values are the defaults.
+    #[test]
+    fn the_example_shows_every_field_with_its_default() {
+        let fields = serde_json::to_value(StudyConfig::default()).unwrap();
+        let fields = fields.as_object().unwrap();
+        for (section, value) in fields {
+            let mut want: Vec<String> = value.as_object().unwrap().keys().cloned().collect();
+            want.sort();
+            assert_eq!(shown_keys(section), want, "[{section}]");
+        }
+        assert_eq!(fields.len(), 3);
+        let parsed = StudyConfig::parse(EXAMPLE_TOML, "study.toml".as_ref()).unwrap();
+        assert_eq!(parsed, StudyConfig::default());
+    }
+
+    /// The crate's README shows the example as it is.
+    #[test]
+    fn the_readme_shows_the_example() {
+        let readme = include_str!("../README.md");
+        assert!(
+            readme.contains(&format!("```toml\n{EXAMPLE_TOML}```")),
+            "hil-study/README.md must show assets/study.toml verbatim"
+        );
     }
 }

@@ -121,7 +121,8 @@ impl Design {
     /// The order in which participant number `participant` (0-based, in
     /// enrolment order) takes the conditions, as indices into
     /// [`conditions`](Self::conditions): the query conditions in the
-    /// counterbalanced order, the baselines first or last.
+    /// counterbalanced order, the baselines first, last or counterbalanced
+    /// ([`BaselinePosition`]).
     pub fn order(&self, participant: usize) -> Vec<usize> {
         let n_query = self
             .conditions
@@ -132,10 +133,22 @@ impl Design {
             Order::Fixed => (0..n_query).collect(),
             Order::BalancedLatinSquare => williams_row(n_query, participant),
         };
-        let baselines = n_query..self.conditions.len();
-        match self.config.baseline_position {
-            BaselinePosition::First => baselines.chain(queries).collect(),
-            BaselinePosition::Last => queries.into_iter().chain(baselines).collect(),
+        let mut baselines: Vec<usize> = (n_query..self.conditions.len()).collect();
+        let first = match self.config.baseline_position {
+            BaselinePosition::First => true,
+            BaselinePosition::Last => false,
+            BaselinePosition::Counterbalanced => {
+                if !baselines.is_empty() {
+                    let turn = (participant / 2) % baselines.len();
+                    baselines.rotate_left(turn);
+                }
+                participant % 2 == 0
+            }
+        };
+        if first {
+            baselines.into_iter().chain(queries).collect()
+        } else {
+            queries.into_iter().chain(baselines).collect()
         }
     }
 }
@@ -221,5 +234,37 @@ mod tests {
         assert_eq!(d.duration_s(), hil_workload::synth::CONDITION_SECONDS);
         assert_eq!(d.conditions()[12].id, "baseline_easy");
         assert_eq!(d.order(5)[..2], [12, 13]);
+    }
+
+    /// Counterbalanced baselines: over four participants, each comes
+    /// first and last, before and after the other, once each; the query
+    /// conditions keep their Latin-square rows.
+    #[test]
+    fn counterbalanced_baselines_take_every_place() {
+        let d = Design::new(DesignConfig {
+            baseline_position: BaselinePosition::Counterbalanced,
+            ..DesignConfig::default()
+        })
+        .unwrap();
+        let (easy, hard) = (12, 13);
+        let placed: Vec<(bool, Vec<usize>)> = (0..4)
+            .map(|p| {
+                let order = d.order(p);
+                let queries: Vec<usize> = order.iter().copied().filter(|&c| c < 12).collect();
+                assert_eq!(queries, williams_row(12, p), "participant {p}");
+                let first = order[0] >= 12;
+                let block = if first { &order[..2] } else { &order[12..] };
+                (first, block.to_vec())
+            })
+            .collect();
+        assert_eq!(
+            placed,
+            vec![
+                (true, vec![easy, hard]),
+                (false, vec![easy, hard]),
+                (true, vec![hard, easy]),
+                (false, vec![hard, easy]),
+            ]
+        );
     }
 }

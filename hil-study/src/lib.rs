@@ -7,13 +7,17 @@
 //!
 //! - [`StudyConfig`]: the design (12 query conditions — difficulty ×
 //!   distraction × interval — and 2 baselines by default), server and
-//!   materials, read from TOML with located errors.
+//!   materials, read from TOML with located errors; every key with its
+//!   default is [`config::EXAMPLE_TOML`].
 //! - [`Design`]: the conditions, their counterbalanced order per
 //!   participant (Williams balanced Latin square) and the query schedule.
 //! - [`StudyServer`]: one data folder, one page per participant behind a
 //!   token, a researcher's progress page; every answer is appended to the
 //!   participant's log and fsync'ed before the page is told it is saved,
-//!   and a restarted server or reopened page resumes where it was.
+//!   and a restarted server or reopened page resumes where it was. The
+//!   researcher's link, the port and a self-signed certificate are kept
+//!   in the data folder, so links stay the same across restarts; beyond
+//!   loopback the pages are served over HTTPS only.
 //! - [`export()`]: the logs as the study CSV, validated by the loader.
 //! - [`materials`]: the drawn food pictures, the queries built on them,
 //!   the addition task and the transcription passage.
@@ -34,4 +38,6 @@ pub mod tlx;
 pub use config::{DesignConfig, MaterialsConfig, ServerConfig, StudyConfig};
 pub use design::{Condition, Design};
 pub use export::{Export, export, export_all};
+/// The certificate of HTTPS (`StudyServer::tls`), from the server crate.
+pub use hil_http::tls::{CertSource, Tls};
 pub use server::StudyServer;

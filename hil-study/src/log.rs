@@ -166,9 +166,13 @@ pub fn read(path: &Path) -> Result<(Vec<Line>, usize)> {
 impl EventLog {
     /// Creates a new log at `path` (refused if it exists) with `first`.
     pub fn create(path: &Path, first: Event) -> Result<Self> {
-        let file = OpenOptions::new()
-            .create_new(true)
-            .append(true)
+        let mut options = OpenOptions::new();
+        options.create_new(true).append(true);
+        // The log holds the participant's link token and answers: the
+        // owner's only, like the researcher's token.
+        #[cfg(unix)]
+        std::os::unix::fs::OpenOptionsExt::mode(&mut options, 0o600);
+        let file = options
             .open(path)
             .map_err(|e| HilError::io("creating", path, e))?;
         let mut log = Self {

@@ -27,6 +27,77 @@ pub const FOODS: [&str; 10] = [
 /// with `passage.txt` in its materials folder).
 pub const DEFAULT_PASSAGE: &str = include_str!("../assets/passage.txt");
 
+/// The materials in use: the passage's words, its pace, the addends, the
+/// lab's pictures.
+#[derive(Debug)]
+pub struct Materials {
+    /// The transcription passage, word by word.
+    pub passage: Vec<String>,
+    /// Words revealed per study minute.
+    pub words_per_min: f64,
+    /// Largest addend.
+    pub addition_max: u32,
+    /// The lab's `images/` folder, if it has one.
+    pub images: Option<std::path::PathBuf>,
+}
+
+impl Materials {
+    /// Loads the lab's folder over the defaults.
+    pub fn load(config: &crate::StudyConfig) -> hil_core::Result<Self> {
+        let m = &config.materials;
+        let mut passage = DEFAULT_PASSAGE.to_string();
+        let mut images = None;
+        if let Some(dir) = &m.dir {
+            if !dir.is_dir() {
+                return Err(hil_core::HilError::invalid_parameter(
+                    "materials.dir",
+                    dir.display(),
+                    "is not a directory",
+                ));
+            }
+            let p = dir.join("passage.txt");
+            if p.exists() {
+                passage = hil_core::files::read_text(&p, hil_core::files::limits::ASSET)?;
+                if passage.split_whitespace().count() < 10 {
+                    return Err(hil_textdata::data_error(
+                        &p,
+                        1,
+                        "passage",
+                        "needs at least 10 words",
+                    ));
+                }
+            }
+            let i = dir.join("images");
+            if i.is_dir() {
+                images = Some(i);
+            }
+        }
+        Ok(Self {
+            passage: passage.split_whitespace().map(str::to_string).collect(),
+            words_per_min: m.transcription_words_per_min,
+            addition_max: m.addition_max,
+            images,
+        })
+    }
+
+    /// Sum `index` of the addition task of condition `c` for participant
+    /// number `number`.
+    pub fn addition(
+        &self,
+        design: &crate::Design,
+        number: usize,
+        c: usize,
+        index: usize,
+    ) -> (u32, u32) {
+        addition(
+            design.config().seed,
+            [number as u64, c as u64],
+            index as u64,
+            self.addition_max,
+        )
+    }
+}
+
 /// A random stream for one use of the materials: the study seed and the
 /// place it is asked (participant, condition, item, purpose).
 fn rng(seed: u64, parts: &[u64]) -> ChaCha8Rng {

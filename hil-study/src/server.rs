@@ -4,9 +4,13 @@
 //!
 //! Data folder layout: `design.json` (the design the data were collected
 //! under; serving it again with another design is refused),
-//! `participants/<id>.jsonl` (each participant's event log) and
-//! `study.lock` (held while a server runs, so two servers never write the
-//! same logs).
+//! `participants/<id>.jsonl` (each participant's event log),
+//! `researcher.token` (the researcher's link, readable by its owner only,
+//! so the link stays the same across restarts), `port` (the last run's
+//! port, taken again when the config asks for any free one), `tls-cert.pem` and
+//! `tls-key.pem` (the self-signed certificate of HTTPS without the lab's
+//! own, kept so its fingerprint stays the same) and `study.lock` (held
+//! while a server runs, so two servers never write the same logs).
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -23,86 +27,48 @@ use serde_json::{Value, json};
 
 use crate::config::{DesignConfig, StudyConfig};
 use crate::design::Design;
-use crate::materials;
+use crate::materials::{self, Materials};
 use crate::session::{Participant, Phase, Refused, Submitted};
 use hil_http::guard::{
     Site, forbidden, random_token, refuse_foreign_post, same_token, split_token,
 };
-use hil_http::page::{CSS, HTML, JS, PAGE_CSS, SCAN_JS, asset, find_picture, with_scan_settings};
-use hil_http::{Limits, Request, Response, Server, Service, urls};
+use hil_http::page::{CSS, HTML, JS, PAGE_CSS, SCAN_JS, assemble, asset, find_picture};
+use hil_http::secrets::stored_token;
+use hil_http::tls::Tls;
+use hil_http::{Limits, Request, Response, Scheme, Server, Service, urls};
 
-/// The participant's page, with the shared switch-scanning settings in its
-/// header.
+/// The participant's page, with the pages' shared head and header.
 static STUDY_HTML: LazyLock<String> =
-    LazyLock::new(|| with_scan_settings(include_str!("../assets/study.html")));
+    LazyLock::new(|| assemble(include_str!("../assets/study.html")));
 const STUDY_JS: &str = include_str!("../assets/study.js");
 const STUDY_CSS: &str = include_str!("../assets/study.css");
-const RESEARCHER_HTML: &str = include_str!("../assets/researcher.html");
+/// The researcher's page, with the pages' shared head and header.
+static RESEARCHER_HTML: LazyLock<String> =
+    LazyLock::new(|| assemble(include_str!("../assets/researcher.html")));
+const RESEARCHER_JS: &str = include_str!("../assets/researcher.js");
 
-/// The materials in use: the passage's words, its pace, the addends, the
-/// lab's pictures.
-#[derive(Debug)]
-pub struct Materials {
-    /// The transcription passage, word by word.
-    pub passage: Vec<String>,
-    /// Words revealed per study minute.
-    pub words_per_min: f64,
-    /// Largest addend.
-    pub addition_max: u32,
-    /// The lab's `images/` folder, if it has one.
-    pub images: Option<PathBuf>,
-}
+/// The file in the data folder that keeps the port of the last run.
+pub const PORT_FILE: &str = "port";
 
-impl Materials {
-    /// Loads the lab's folder over the defaults.
-    pub fn load(config: &StudyConfig) -> Result<Self> {
-        let m = &config.materials;
-        let mut passage = materials::DEFAULT_PASSAGE.to_string();
-        let mut images = None;
-        if let Some(dir) = &m.dir {
-            if !dir.is_dir() {
-                return Err(HilError::invalid_parameter(
-                    "materials.dir",
-                    dir.display(),
-                    "is not a directory",
-                ));
-            }
-            let p = dir.join("passage.txt");
-            if p.exists() {
-                passage = hil_core::files::read_text(&p, hil_core::files::limits::ASSET)?;
-                if passage.split_whitespace().count() < 10 {
-                    return Err(hil_textdata::data_error(
-                        &p,
-                        1,
-                        "passage",
-                        "needs at least 10 words",
-                    ));
-                }
-            }
-            let i = dir.join("images");
-            if i.is_dir() {
-                images = Some(i);
-            }
-        }
-        Ok(Self {
-            passage: passage.split_whitespace().map(str::to_string).collect(),
-            words_per_min: m.transcription_words_per_min,
-            addition_max: m.addition_max,
-            images,
-        })
+/// The port the last run listened on, if it left one.
+fn last_port(path: &Path) -> Result<Option<u16>> {
+    if !path.exists() {
+        return Ok(None);
     }
-
-    /// Sum `index` of the addition task of condition `c` for participant
-    /// number `number`.
-    pub fn addition(&self, design: &Design, number: usize, c: usize, index: usize) -> (u32, u32) {
-        materials::addition(
-            design.config().seed,
-            [number as u64, c as u64],
-            index as u64,
-            self.addition_max,
-        )
+    let text = hil_core::files::read_text(path, hil_core::files::limits::CONFIG)?;
+    match text.trim().parse::<u16>() {
+        Ok(p) if p > 0 => Ok(Some(p)),
+        _ => Err(hil_textdata::data_error(
+            path,
+            1,
+            "port",
+            "must be a port number from 1 to 65535 (delete the file to take any free port)",
+        )),
     }
 }
+
+/// The file in the data folder that keeps the researcher's token.
+pub const RESEARCHER_TOKEN_FILE: &str = "researcher.token";
 
 /// Everything the handlers share.
 struct Shared {
@@ -138,6 +104,10 @@ pub struct StudyServer {
     server: Server,
     /// Never empty: `start` refuses to run without an address to print.
     hosts: Vec<IpAddr>,
+    /// The certificate, when served over HTTPS.
+    tls: Option<Tls>,
+    /// The last run's port, when it was taken and another one is used.
+    moved_from: Option<u16>,
     _lock: File,
 }
 
@@ -253,21 +223,48 @@ impl StudyServer {
             design,
             materials,
             dir: dir.to_path_buf(),
-            researcher_token: random_token(),
+            researcher_token: stored_token(&dir.join(RESEARCHER_TOKEN_FILE))?,
             site: Site::new(&config.server.allowed_hosts),
             away: Duration::from_secs_f64(config.server.away_after_s),
             participants: Mutex::new(participants),
         });
         let bind = SocketAddr::new(config.server.bind, config.server.port);
         let channel_error = |why: String| HilError::channel("study", why);
-        let server = Server::start(bind, Arc::new(Pages(shared.clone())), Limits::default())
-            .map_err(|e| channel_error(format!("cannot listen on {bind}: {e}")))?;
-        shared.site.set_port(server.addr().port());
-        let hosts = urls::hosts_to_print(server.addr()).map_err(channel_error)?;
+        let hosts = urls::hosts_to_print(bind).map_err(channel_error)?;
+        let tls = tls_for(&config, dir, &hosts)?;
+        let listen = |port: u16| {
+            let at = SocketAddr::new(bind.ip(), port);
+            let pages = Arc::new(Pages(shared.clone()));
+            match &tls {
+                Some(tls) => Server::start_tls(at, pages, Limits::default(), tls),
+                None => Server::start(at, pages, Limits::default()),
+            }
+        };
+        // Any free port was asked for: the last run's, if it is still
+        // free, so that the links printed then still open.
+        let port_path = dir.join(PORT_FILE);
+        let last_port = match config.server.port {
+            0 => last_port(&port_path)?,
+            _ => None,
+        };
+        let (server, moved_from) = match last_port {
+            Some(p) => match listen(p) {
+                Ok(s) => (Ok(s), None),
+                Err(_) => (listen(0), Some(p)),
+            },
+            None => (listen(bind.port()), None),
+        };
+        let server = server.map_err(|e| channel_error(format!("cannot listen on {bind}: {e}")))?;
+        let port = server.addr().port();
+        std::fs::write(&port_path, format!("{port}\n"))
+            .map_err(|e| HilError::io("writing", &port_path, e))?;
+        shared.site.set_port(port);
         Ok(Self {
             shared,
             server,
+            moved_from,
             hosts,
+            tls,
             _lock: lock,
         })
     }
@@ -277,11 +274,29 @@ impl StudyServer {
         self.server.addr()
     }
 
+    /// The port of the last run on this data folder, when it was taken by
+    /// something else and the server listens on another: the links
+    /// printed before no longer open.
+    pub fn moved_from(&self) -> Option<u16> {
+        self.moved_from
+    }
+
+    /// The certificate the pages are served with over HTTPS (`None`: plain
+    /// HTTP, on loopback only), for its fingerprint.
+    pub fn tls(&self) -> Option<&Tls> {
+        self.tls.as_ref()
+    }
+
     fn links(&self, token: &str) -> Vec<String> {
         let port = self.server.addr().port();
+        let scheme = if self.tls.is_some() {
+            Scheme::Https
+        } else {
+            Scheme::Http
+        };
         self.hosts
             .iter()
-            .map(|&ip| urls::page_url(ip, port, token))
+            .map(|&ip| urls::page_url_over(scheme, ip, port, token))
             .collect()
     }
 
@@ -290,11 +305,44 @@ impl StudyServer {
         self.links(&self.shared.researcher_token)
     }
 
-    /// Enrols a participant of `population`: their pseudonymous id and
-    /// the URLs of their page.
+    /// Enrols a participant of `population` under the next free id
+    /// (`p001`, `p002`, …; the researcher page's button): their id and the
+    /// URLs of their page.
     pub fn enrol(&self, population: Population) -> Result<(String, Vec<String>)> {
-        let (id, token) = enrol(&self.shared, population)?;
+        let (id, token) = enrol(&self.shared, None, population)?;
         Ok((id, self.links(&token)))
+    }
+
+    /// Enrols participant `id` of `population`, unless `id` is enrolled
+    /// already with that population: then nothing changes
+    /// ([`Enrolment::Already`]), so a serve command that names its
+    /// participants can be run again after a restart without enrolling
+    /// anyone twice. An id enrolled with another population is refused.
+    /// The URLs of their page either way.
+    pub fn enrol_as(&self, id: &str, population: Population) -> Result<(Enrolment, Vec<String>)> {
+        check_participant_id(id)?;
+        let known = {
+            let ps = self.shared.lock();
+            ps.values()
+                .find(|p| p.id == id)
+                .map(|p| (p.population, p.token.clone()))
+        };
+        match known {
+            Some((was, token)) if was == population => Ok((Enrolment::Already, self.links(&token))),
+            Some((was, _)) => Err(HilError::invalid_parameter(
+                "enrol",
+                format!("{id}={}", population.as_str()),
+                format!(
+                    "participant {id} is enrolled already as {}; give a new id to enrol \
+                     someone else",
+                    was.as_str()
+                ),
+            )),
+            None => {
+                let (_, token) = enrol(&self.shared, Some(id), population)?;
+                Ok((Enrolment::New, self.links(&token)))
+            }
+        }
     }
 
     /// The URLs of participant `id`'s page.
@@ -306,10 +354,77 @@ impl StudyServer {
     }
 }
 
-fn enrol(shared: &Shared, population: Population) -> Result<(String, String)> {
+/// The certificate to serve with: none on loopback unless asked (plain
+/// HTTP never leaves the machine), the lab's if given, else the data
+/// folder's self-signed one (made for `hosts` and the allowed host names
+/// at the first start).
+fn tls_for(config: &StudyConfig, dir: &Path, hosts: &[IpAddr]) -> Result<Option<Tls>> {
+    let server = &config.server;
+    if !server.uses_https() {
+        return Ok(None);
+    }
+    Ok(Some(match (&server.tls_cert, &server.tls_key) {
+        (Some(cert), Some(key)) => Tls::from_pem_files(cert, key)?,
+        _ => {
+            let names: Vec<String> = hosts
+                .iter()
+                .map(IpAddr::to_string)
+                .chain(server.allowed_hosts.iter().cloned())
+                .collect();
+            Tls::self_signed_in(dir, &names)?
+        }
+    }))
+}
+
+/// Whether [`StudyServer::enrol_as`] enrolled someone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Enrolment {
+    /// A new participant, with the next counterbalancing row.
+    New,
+    /// The id was enrolled already with that population: nothing changed.
+    Already,
+}
+
+/// A participant id is a pseudonym that names their log file: 1 to 16
+/// lower-case letters, digits, `-` or `_`, starting with a letter (`p001`).
+pub fn check_participant_id(id: &str) -> Result<()> {
+    let ok = (1..=16).contains(&id.len())
+        && id.starts_with(|c: char| c.is_ascii_lowercase())
+        && id
+            .bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-' || b == b'_');
+    if ok {
+        Ok(())
+    } else {
+        Err(HilError::invalid_parameter(
+            "participant id",
+            id,
+            "must be 1 to 16 lower-case letters, digits, `-` or `_`, starting with a letter \
+             (a pseudonym such as p001, never a name)",
+        ))
+    }
+}
+
+/// Enrols a participant as `id` (or the first free `p001`, `p002`, …),
+/// with the next counterbalancing row; their id and token.
+fn enrol(shared: &Shared, id: Option<&str>, population: Population) -> Result<(String, String)> {
     let mut ps = shared.lock();
     let number = ps.len();
-    let id = format!("p{:03}", number + 1);
+    let taken = |id: &str| ps.values().any(|p| p.id == id);
+    let id = match id {
+        Some(id) if taken(id) => {
+            return Err(HilError::invalid_parameter(
+                "participant id",
+                id,
+                "is enrolled already",
+            ));
+        }
+        Some(id) => id.to_string(),
+        None => (1..)
+            .map(|n| format!("p{n:03}"))
+            .find(|id| !taken(id))
+            .expect("an unbounded range has a free id"),
+    };
     let token = random_token();
     let path = shared.dir.join("participants").join(format!("{id}.jsonl"));
     let p = Participant::enrol(
@@ -394,7 +509,9 @@ fn handle(shared: &Shared, req: &Request) -> Response {
 
 fn researcher(shared: &Shared, req: &Request, rest: &str) -> Response {
     match (req.method.as_str(), rest) {
-        ("GET", "") => asset(RESEARCHER_HTML, HTML),
+        ("GET", "") => asset(RESEARCHER_HTML.as_str(), HTML),
+        ("GET", "researcher.js") => asset(RESEARCHER_JS, JS),
+        ("GET", "scan.js") => asset(SCAN_JS, JS),
         ("GET", "app.css") => asset(PAGE_CSS, CSS),
         ("GET", "study.css") => asset(STUDY_CSS, CSS),
         ("GET", "api/progress") => Response::json(200, &progress(shared)),
@@ -408,7 +525,7 @@ fn researcher(shared: &Shared, req: &Request, rest: &str) -> Response {
                 Ok(e) => e,
                 Err(e) => return Response::json(400, &json!({"error": e.to_string()})),
             };
-            match enrol(shared, parsed.population) {
+            match enrol(shared, None, parsed.population) {
                 Ok((id, token)) => Response::json(
                     200,
                     &json!({"participant": id, "link": format!("/{token}/")}),

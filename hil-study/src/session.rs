@@ -704,7 +704,7 @@ impl Participant {
         condition: &str,
         index: usize,
         answer: String,
-        materials: &crate::server::Materials,
+        materials: &crate::materials::Materials,
     ) -> std::result::Result<Submitted, Refused> {
         if self.is_past(design, condition, index < self.progress.distraction_answers) == Some(true)
         {
@@ -757,7 +757,7 @@ impl Participant {
     }
 
     /// What the participant's page shows now.
-    pub fn view(&self, design: &Design, materials: &crate::server::Materials) -> Value {
+    pub fn view(&self, design: &Design, materials: &crate::materials::Materials) -> Value {
         let phase = self.phase(design);
         let Some(c) = self.current() else {
             return json!({"phase": "done", "participant": self.id});

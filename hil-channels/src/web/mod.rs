@@ -15,16 +15,13 @@ use hil_http::guard::{
     Site, check_allowed_hosts, forbidden, random_token, refuse_foreign_post, same_token,
     split_token,
 };
-use hil_http::page::{
-    CSS, HTML, JS, PAGE_CSS, Picture, SCAN_JS, asset, find_picture, with_scan_settings,
-};
+use hil_http::page::{CSS, HTML, JS, PAGE_CSS, Picture, SCAN_JS, assemble, asset, find_picture};
 use hil_http::{Limits, Occupancy, Request, Response as HttpResponse, Server, Service, urls};
 
 use crate::present::{describe_item, describe_kind, question, validate_answer};
 
-/// The page, with the shared switch-scanning settings in its header.
-static PAGE_HTML: LazyLock<String> =
-    LazyLock::new(|| with_scan_settings(include_str!("page.html")));
+/// The page, with the pages' shared head and header (switch scanning).
+static PAGE_HTML: LazyLock<String> = LazyLock::new(|| assemble(include_str!("page.html")));
 const PAGE_JS: &str = include_str!("page.js");
 
 /// The default time a person has to answer before the policy acts alone.

@@ -14,8 +14,8 @@ use std::time::{Duration, Instant};
 
 use hil_channels::{WebChannel, WebChannelConfig};
 use hil_core::{
-    Answer, ArmId, Context, Difficulty, Distraction, Item, Query, QueryChannel, QueryKind,
-    Response, ResponseType,
+    Answer, ArmId, BoundingBox, Context, Difficulty, Distraction, Item, Query, QueryChannel,
+    QueryKind, Response, ResponseType,
 };
 use serde_json::json;
 
@@ -164,11 +164,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
         "{readout}"
     );
     browser.click("#send-box");
-    let (ch, r) = asking.join().unwrap();
-    wait_until_no_question(&browser);
-    let Answer::BoundingBox { bbox } = r.answer else {
-        panic!("{:?}", r.answer)
-    };
+    let (ch, r, bbox) = box_answer(asking, &browser);
     // Dragged from left of and above the centre to right of and below it.
     assert!(
         bbox.x0 < 0.5 && bbox.x1 > 0.5 && bbox.y0 < 0.5 && bbox.y1 > 0.5,
@@ -184,11 +180,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     let asking = ask_async(ch, query(4, ResponseType::BoundingBox));
     browser.click("#region-8");
     browser.click("#send-box");
-    let (ch, r) = asking.join().unwrap();
-    wait_until_no_question(&browser);
-    let Answer::BoundingBox { bbox } = r.answer else {
-        panic!("{:?}", r.answer)
-    };
+    let (ch, _, bbox) = box_answer(asking, &browser);
     assert!(
         (bbox.x0 - 2.0 / 3.0).abs() < 1e-9 && (bbox.y1 - 1.0).abs() < 1e-9,
         "{bbox:?}"
@@ -201,11 +193,7 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
     browser.script("document.getElementById('bbox-canvas').focus();");
     browser.keys(&["\u{E014}", "\u{E014}", "\u{E014}"]); // ArrowRight ×3
     browser.click("#send-box");
-    let (ch, r) = asking.join().unwrap();
-    wait_until_no_question(&browser);
-    let Answer::BoundingBox { bbox } = r.answer else {
-        panic!("{:?}", r.answer)
-    };
+    let (ch, _, bbox) = box_answer(asking, &browser);
     assert!(
         (bbox.x0 - 0.46).abs() < 1e-6 && (bbox.x1 - 0.66).abs() < 1e-6,
         "{bbox:?}"
@@ -251,6 +239,20 @@ fn a_person_answers_every_kind_of_query_in_chromium() {
         std::thread::sleep(Duration::from_millis(50));
     }
     drop(ch);
+}
+
+/// The answer `asking` gets, once the page has taken the question down;
+/// it must be a bounding box.
+fn box_answer(
+    asking: JoinHandle<(WebChannel, Response)>,
+    browser: &Browser,
+) -> (WebChannel, Response, BoundingBox) {
+    let (ch, r) = asking.join().unwrap();
+    wait_until_no_question(browser);
+    let Answer::BoundingBox { bbox } = r.answer else {
+        panic!("{:?}", r.answer)
+    };
+    (ch, r, bbox)
 }
 
 /// Waits until the page has taken its last answer down. The channel

@@ -38,7 +38,7 @@ fn serve(config: &Path, data: &Path, enrol: bool) -> Serve {
         .arg("--data")
         .arg(data);
     if enrol {
-        cmd.args(["--enrol", "mobility_limitation"]);
+        cmd.args(["--enrol", "p001=mobility_limitation"]);
     }
     let mut child = cmd.stdout(Stdio::piped()).spawn().unwrap();
     let mut out = BufReader::new(child.stdout.take().unwrap());
@@ -204,8 +204,19 @@ fn killed_mid_condition_the_study_resumes_without_loss_or_duplicates() {
         3
     );
 
-    // Served again: the participant's link comes from the researcher's page.
-    let mut b = serve(&config, &data, false);
+    // Served again with the same command: nobody new is enrolled, and the
+    // researcher's and the participant's links hold the tokens printed
+    // before (the port is a free one, as the config asks).
+    let mut b = serve(&config, &data, true);
+    let token = |url: &str| {
+        url.trim_end_matches('/')
+            .rsplit('/')
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(token(&b.researcher), token(&a.researcher));
+    assert_eq!(b.participant.as_deref().map(token), Some(token(&p)));
     let (s, progress) = request(&b.researcher, "api/progress", None);
     assert_eq!(s, 200);
     let row = &progress["participants"][0];

@@ -80,6 +80,22 @@ impl std::fmt::Debug for Browser {
 impl Browser {
     /// Starts chromedriver on a free loopback port and opens a session.
     pub fn start() -> Self {
+        Self::start_with(&[])
+    }
+
+    /// As [`start`](Self::start), trusting the HTTPS server whose
+    /// certificate has this public key (Chromium pins it by the SHA-256 of
+    /// its SubjectPublicKeyInfo, [`Tls::public_key_sha256`]); any other
+    /// certificate error still stops the page.
+    ///
+    /// [`Tls::public_key_sha256`]: crate::tls::Tls::public_key_sha256
+    pub fn start_trusting(public_key_sha256: [u8; 32]) -> Self {
+        use base64::Engine;
+        let pin = base64::engine::general_purpose::STANDARD.encode(public_key_sha256);
+        Self::start_with(&[format!("--ignore-certificate-errors-spki-list={pin}")])
+    }
+
+    fn start_with(extra_args: &[String]) -> Self {
         let port = TcpListener::bind("127.0.0.1:0")
             .unwrap()
             .local_addr()
@@ -101,19 +117,26 @@ impl Browser {
             std::env::temp_dir().join(format!("hil-chromium-{}-{port}", std::process::id()));
         let _ = std::fs::remove_dir_all(&profile);
         std::fs::create_dir_all(&profile).unwrap();
+        let mut args: Vec<String> = [
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            // A phone-sized window: the page must work there.
+            "--window-size=412,915",
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect();
+        args.push(format!("--user-data-dir={}", profile.display()));
+        args.extend(extra_args.iter().cloned());
         let caps = json!({"capabilities": {"alwaysMatch": {
             "browserName": "chrome",
-            "goog:chromeOptions": {
-                "binary": CHROMIUM,
-                "args": [
-                    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-                    "--no-first-run", "--disable-background-networking",
-                    "--disable-component-update", "--disable-sync",
-                    format!("--user-data-dir={}", profile.display()),
-                    // A phone-sized window: the page must work there.
-                    "--window-size=412,915",
-                ]
-            }
+            "goog:chromeOptions": { "binary": CHROMIUM, "args": args }
         }}});
         let mut b = Self {
             driver,

@@ -3,9 +3,12 @@
 //! conditions (easy and hard queries, transcription task) with the time
 //! scale at 60 (a study minute lasts a second). They answer every query
 //! type and every survey, start the last part by single-switch scanning,
-//! and midway close the page and open their link again. The live page
-//! passes the accessibility checks; the export passes the study loader,
-//! has the expected pairs and fits a model.
+//! and midway close the page and open their link again. The pages are
+//! served over HTTPS with the data folder's self-signed certificate, which
+//! the browser trusts by its pinned public key (on loopback). The live page
+//! passes the accessibility checks; the researcher's page shows the
+//! progress and enrols; the export passes the study loader, has the
+//! expected pairs and fits a model.
 
 use std::time::{Duration, Instant};
 
@@ -25,6 +28,9 @@ distractions = ["hard"]
 intervals_min = [1]
 baselines = ["easy"]
 time_scale = 60
+
+[server]
+https = true
 "#;
 
 const TAB: &str = "\u{E004}";
@@ -128,9 +134,9 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
     let server = StudyServer::start(config, &dir).unwrap();
     let (id, urls) = server.enrol(Population::MobilityLimitation).unwrap();
     assert_eq!(id, "p001");
-    assert!(urls[0].starts_with("http://127.0.0.1:"), "{urls:?}");
+    assert!(urls[0].starts_with("https://127.0.0.1:"), "{urls:?}");
 
-    let b = Browser::start();
+    let b = Browser::start_trusting(server.tls().unwrap().public_key_sha256());
     b.goto(&urls[0]);
     let mut seen = std::collections::BTreeSet::new();
     let mut surveys = 0;
@@ -276,6 +282,33 @@ fn a_scripted_participant_completes_a_shortened_study_by_keyboard() {
     // 5 queries in each of 2 conditions, each with a survey, and one
     // survey at the end of each of the 3 conditions.
     assert_eq!(surveys, 13);
+
+    // The researcher's page (its script is a file: the security policy
+    // runs no inline script) shows the progress and enrols over HTTPS.
+    b.goto(&server.researcher_urls()[0]);
+    b.find("#scan-toggle");
+    let row = b.find("#rows tr");
+    let text = b.cmd("GET", &format!("/element/{row}/text"), json!({}));
+    assert!(
+        text.as_str()
+            .unwrap()
+            .starts_with("p001 mobility_limitation 3 / 3"),
+        "{text}"
+    );
+    b.click("#enrol");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let said = b.script("return document.getElementById('enrolled').textContent;");
+        if said
+            .as_str()
+            .unwrap()
+            .starts_with("Enrolled p002: https://127.0.0.1:")
+        {
+            break;
+        }
+        assert!(Instant::now() < deadline, "{said}");
+        std::thread::sleep(Duration::from_millis(50));
+    }
     drop(b);
     drop(server);
 

@@ -397,3 +397,144 @@ fn a_log_line_about_another_condition_is_refused_in_plain_words() {
     assert!(!e.contains("Some("), "no Rust Debug output: {e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The researcher's link is kept in the data folder (the owner's only) and
+/// works after a restart; an enrolment that names its participant is not
+/// made twice when the serve command runs again.
+#[test]
+fn links_and_named_enrolments_survive_a_restart() {
+    use hil_study::server::{Enrolment, RESEARCHER_TOKEN_FILE};
+    let dir = temp_dir("restart-links");
+    let server = StudyServer::start(config(""), &dir).unwrap();
+    let researcher = server.researcher_urls()[0].clone();
+    let (done, first) = server
+        .enrol_as("p001", Population::MobilityLimitation)
+        .unwrap();
+    assert_eq!(done, Enrolment::New);
+    drop(server);
+    wait_for_lock_release(&dir);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        for secret in [RESEARCHER_TOKEN_FILE, "participants/p001.jsonl"] {
+            let meta = std::fs::metadata(dir.join(secret)).unwrap();
+            assert_eq!(meta.permissions().mode() & 0o777, 0o600, "{secret}");
+        }
+    }
+
+    let server = StudyServer::start(config(""), &dir).unwrap();
+    let addr = server.addr();
+    // The old link (same token, and the last run's port unless something
+    // else took it meanwhile) still opens the progress page.
+    let old = token_of(&researcher);
+    match server.moved_from() {
+        None => assert_eq!(server.researcher_urls()[0], researcher),
+        Some(p) => assert_eq!(researcher, format!("http://127.0.0.1:{p}/{old}/")),
+    }
+    assert_eq!(token_of(&server.researcher_urls()[0]), old);
+    let (s, body) = get(addr, &format!("/{old}/api/progress"));
+    assert_eq!(s, 200, "{body}");
+    // Enrolling p001 again with the same population changes nothing.
+    let (done, again) = server
+        .enrol_as("p001", Population::MobilityLimitation)
+        .unwrap();
+    assert_eq!(done, Enrolment::Already);
+    assert_eq!(token_of(&again[0]), token_of(&first[0]));
+    let progress: Value =
+        serde_json::from_str(&get(addr, &format!("/{old}/api/progress")).1).unwrap();
+    assert_eq!(
+        progress["participants"].as_array().unwrap().len(),
+        1,
+        "{progress}"
+    );
+    // With another population, it is refused; a name-like id too.
+    let e = server
+        .enrol_as("p001", Population::NoLimitation)
+        .unwrap_err();
+    assert!(matches!(e, HilError::InvalidParameter { .. }), "{e:?}");
+    let e = server
+        .enrol_as("Jane Doe", Population::NoLimitation)
+        .unwrap_err();
+    assert!(matches!(e, HilError::InvalidParameter { .. }), "{e:?}");
+    // The researcher page's button takes the next free id.
+    let (id, _) = server.enrol(Population::NoLimitation).unwrap();
+    assert_eq!(id, "p002");
+    let (done, _) = server.enrol_as("p004", Population::NoLimitation).unwrap();
+    assert_eq!(done, Enrolment::New);
+    assert_eq!(server.enrol(Population::NoLimitation).unwrap().0, "p003");
+    assert_eq!(server.enrol(Population::NoLimitation).unwrap().0, "p005");
+    drop(server);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Over HTTPS (asked for on loopback here; `--lan` always serves it): the
+/// pages answer a client that pins the printed fingerprint, answers come
+/// only from the https origin, plain HTTP gets no page, and a restart
+/// keeps the self-signed certificate. Only loopback is used.
+#[test]
+fn https_serves_the_pages_with_a_kept_certificate() {
+    use hil_http::testing::client::{get_https, post_https, raw};
+    let dir = temp_dir("https");
+    let cfg = config("[server]\nhttps = true\n");
+    let server = StudyServer::start(cfg.clone(), &dir).unwrap();
+    let addr = server.addr();
+    assert!(addr.ip().is_loopback());
+    let fingerprint = server.tls().expect("served over HTTPS").fingerprint();
+    let (_, urls) = server.enrol(Population::NoLimitation).unwrap();
+    assert!(urls[0].starts_with("https://127.0.0.1:"), "{urls:?}");
+    let token = token_of(&urls[0]);
+    let (s, page) = get_https(addr, &fingerprint, &format!("/{token}/"));
+    assert_eq!(s, 200);
+    assert!(page.contains("<html"), "{page}");
+    let start = json!({"condition": "c01"}).to_string();
+    let json = "Content-Type: application/json\r\n";
+    let (s, _) = post_https(
+        addr,
+        &fingerprint,
+        &format!("/{token}/api/start"),
+        &format!("Origin: http://{addr}\r\n{json}"),
+        &start,
+    );
+    assert_eq!(s, 403, "the http origin is another origin");
+    let (s, body) = post_https(
+        addr,
+        &fingerprint,
+        &format!("/{token}/api/start"),
+        &format!("Origin: https://{addr}\r\n{json}"),
+        &start,
+    );
+    assert_eq!(s, 200, "{body}");
+    // Plain HTTP to the HTTPS port gets no page.
+    let plain = std::panic::catch_unwind(|| {
+        raw(
+            addr,
+            format!("GET /{token}/ HTTP/1.1\r\nHost: {addr}\r\n\r\n").as_bytes(),
+        )
+    });
+    assert!(!matches!(plain, Ok((200, _))), "{plain:?}");
+    drop(server);
+    wait_for_lock_release(&dir);
+    let server = StudyServer::start(cfg, &dir).unwrap();
+    assert_eq!(server.tls().unwrap().fingerprint(), fingerprint);
+    let (s, _) = get_https(server.addr(), &fingerprint, &format!("/{token}/api/state"));
+    assert_eq!(s, 200);
+    drop(server);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Beyond loopback the study is always served over HTTPS; on loopback
+/// only when asked.
+#[test]
+fn plain_http_stays_on_loopback() {
+    let mut s = hil_study::ServerConfig::default();
+    assert!(!s.uses_https());
+    for bind in ["0.0.0.0", "::", "192.168.1.20"] {
+        s.bind = bind.parse().unwrap();
+        assert!(s.uses_https(), "{bind}");
+    }
+    let e = StudyConfig::parse("[server]\ntls_cert = \"c.pem\"\n", "s.toml".as_ref()).unwrap_err();
+    let HilError::Config(c) = &e else {
+        panic!("{e:?}")
+    };
+    assert_eq!(c.field.as_deref(), Some("server.tls_cert"), "{e}");
+}

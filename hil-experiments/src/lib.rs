@@ -48,6 +48,7 @@ pub mod published;
 pub mod recorded;
 pub mod report;
 pub mod results;
+pub mod results_page;
 pub mod run;
 pub mod testbed;
 pub mod user_study;

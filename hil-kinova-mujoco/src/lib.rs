@@ -36,6 +36,8 @@ mod attempt_log;
 #[cfg(feature = "physics")]
 mod calibrate;
 #[cfg(feature = "physics")]
+pub mod calibration_text;
+#[cfg(feature = "physics")]
 mod controller;
 #[cfg(feature = "physics")]
 mod env;

@@ -16,10 +16,14 @@
 use std::path::{Path, PathBuf};
 
 use hil_core::{HilError, Result};
-use hil_experiments::user_study::{Plate, UserStudyConfig, UserStudyOverSeeds, UserStudyResult};
+use hil_experiments::results_page::ResultsPage;
+use hil_experiments::user_study::text::{NOTE, over_seeds_text, result_text};
+use hil_experiments::user_study::{Plate, UserStudyConfig};
+use hil_kinova_mujoco::calibration_text::{
+    over_seeds_text as calibration_over_seeds_text, run_text,
+};
 use hil_kinova_mujoco::{
-    AttemptLog, CalibrationOptions, CalibrationReport, CalibrationRow, Consistency, FoodKind,
-    Label, RollBy, calibrate_over_seeds, parse_labels,
+    AttemptLog, CalibrationOptions, FoodKind, Label, RollBy, calibrate_over_seeds, parse_labels,
 };
 
 /// Arguments of `hil kinova`.
@@ -74,6 +78,10 @@ pub struct CalibrateArgs {
     /// Print a JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Also keep the printed report as a Markdown results page at this
+    /// path (e.g. docs/results/kinova-calibration.md), naming this command line.
+    #[arg(long, value_name = "FILE", conflicts_with = "json")]
+    pub write_doc: Option<PathBuf>,
     /// No progress output.
     #[arg(long, short)]
     pub quiet: bool,
@@ -133,6 +141,10 @@ pub struct KinovaDemoArgs {
     /// Print a JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Also keep the printed report as a Markdown results page at this
+    /// path (e.g. docs/results/kinova-user-study.md), naming this command line.
+    #[arg(long, value_name = "FILE", conflicts_with = "json")]
+    pub write_doc: Option<PathBuf>,
     /// No progress output.
     #[arg(long, short)]
     pub quiet: bool,
@@ -229,56 +241,22 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     if over.runs.len() == 1 {
         let report = over.runs.remove(0);
         if args.json {
-            print_json(&report)?;
-        } else {
-            print_run(&opts, &report);
+            return print_json(&report);
         }
-        return Ok(());
+        return emit(
+            &run_text(&opts, &report),
+            args.write_doc.as_deref(),
+            CALIBRATION_TITLE,
+        );
     }
     if args.json {
         return print_json(&over);
     }
-    let first = &over.runs[0];
-    println!(
-        "{} runs, master seeds {}..={}; attempts of all runs pooled, rate ± binomial SE (published):",
-        over.runs.len(),
-        seeds[0],
-        seeds[seeds.len() - 1]
-    );
-    print_tool(first.roll_by);
-    print_table(&over.pooled);
-    for (run, seed) in over.runs.iter().zip(&seeds) {
-        println!(
-            "seed {seed}: mean |simulated - published| {:.3}, largest {:.3}: target {}",
-            run.mean_abs_error,
-            run.max_abs_error,
-            met(run.meets_target)
-        );
-    }
-    let t = over.target;
-    println!(
-        "over {} runs (mean ± SE): mean |simulated - published| {:.3} ± {:.3}, largest {:.3} ± {:.3} (a perfect simulator: {:.3} and {:.3}); target (mean <= {:.2}, no cell off by more than {:.2}) met in {} of {} runs, where a perfect simulator meets it in {:.0}% of runs",
-        over.runs.len(),
-        over.mean_abs_error.mean,
-        over.mean_abs_error.se,
-        over.max_abs_error.mean,
-        over.max_abs_error.se,
-        over.noise_floor,
-        over.noise_floor_worst_cell,
-        t.mean_abs_error,
-        t.worst_cell,
-        over.runs_meeting_target,
-        over.runs.len(),
-        100.0 * over.perfect_simulator_meets_target
-    );
-    print_consistency("pooled overall cells", &over.pooled_consistency);
-    print_consistency(
-        "pooled per-setting cells",
-        &over.pooled_consistency_by_setting,
-    );
-    print!("seed {}'s run: ", seeds[0]);
-    print_throughput(first);
-    Ok(())
+    emit(
+        &calibration_over_seeds_text(&over),
+        args.write_doc.as_deref(),
+        CALIBRATION_TITLE,
+    )
 }
 
 fn print_json(value: &impl serde::Serialize) -> Result<()> {
@@ -288,140 +266,6 @@ fn print_json(value: &impl serde::Serialize) -> Result<()> {
     );
     Ok(())
 }
-
-fn met(yes: bool) -> &'static str {
-    if yes { "met" } else { "not met" }
-}
-
-/// One run: the table and how it stands against the target.
-fn print_run(opts: &CalibrationOptions, report: &CalibrationReport) {
-    let per_setting = opts.trials / opts.settings.len();
-    println!(
-        "Simulated success rate (published rate) per action; {} trials each ({} per setting).",
-        opts.trials, per_setting
-    );
-    print_tool(report.roll_by);
-    print_table(&report.rows);
-    println!(
-        "mean |simulated - published| = {:.3} overall (largest {:.3}), {:.3} per setting; hold {:.1} s",
-        report.mean_abs_error,
-        report.max_abs_error,
-        report.mean_abs_error_by_setting,
-        report.hold_s,
-    );
-    println!(
-        "a perfect simulator (true rates = the published ones) would still average {:.3}, with a worst cell of {:.3} expected: the sampling noise of {} published trials per setting and of these",
-        report.noise_floor,
-        report.noise_floor_worst_cell,
-        hil_paper::food_data::TRIALS_PER_SETTING
-    );
-    let t = report.target;
-    println!(
-        "target (mean <= {:.2}, no cell off by more than {:.2}): {}; a perfect simulator meets it in {:.0}% of runs with these trial counts",
-        t.mean_abs_error,
-        t.worst_cell,
-        met(report.meets_target),
-        100.0 * report.perfect_simulator_meets_target
-    );
-    print_consistency("overall cells", &report.consistency);
-    print_consistency("per-setting cells", &report.consistency_by_setting);
-    print_throughput(report);
-}
-
-fn print_tool(roll_by: RollBy) {
-    println!(
-        "Simulated attempts with synthetic food properties, tool `{}`{}; published: Feng et al. 2019.",
-        roll_by.name(),
-        match roll_by {
-            RollBy::ArmYaw => " (the published data set's rigid fork)",
-            RollBy::ForkGamma =>
-                " (the study's 2-DoF fork: not the tool the published rates measured)",
-        }
-    );
-}
-
-/// The rows, one line per food and one per setting under it.
-fn print_table(rows: &[CalibrationRow]) {
-    print!("{:<22}", "food");
-    for a in hil_envs::feeding::action_space().names() {
-        print!("{a:>18}");
-    }
-    println!();
-    for chunk in rows.chunks(6) {
-        print!("{:<22}", chunk[0].food);
-        for r in chunk {
-            print!(
-                "{:>18}",
-                cell(r.counts.rate, r.counts.se, r.published, r.p_value)
-            );
-        }
-        println!();
-        for (i, c) in chunk[0].by_setting.iter().enumerate() {
-            print!("{:<22}", format!("  {}", c.setting.name()));
-            for r in chunk {
-                let c = &r.by_setting[i];
-                print!(
-                    "{:>18}",
-                    cell(c.counts.rate, c.counts.se, c.published, c.p_value)
-                );
-            }
-            println!();
-        }
-    }
-    println!("* p < 0.05: a difference from the published rate that chance alone explains poorly");
-    let discarded: usize = rows.iter().map(|r| r.counts.discarded).sum();
-    println!(
-        "{discarded} of {} attempts discarded (fewer than {} tines touched the item, as in the published data set); rates are over the rest",
-        rows.iter().map(|r| r.counts.trials).sum::<usize>(),
-        hil_kinova_mujoco::MIN_TINES_TOUCHED
-    );
-}
-
-fn print_consistency(what: &str, c: &Consistency) {
-    println!(
-        "chance alone (Fisher's exact test per cell, simulated vs published counts), {what}: {} of {} below p = 0.05 (p = {:.3} for this many); least consistent {} (p = {:.3}; {:.3} after Bonferroni over {} cells)",
-        c.below_0_05,
-        c.cells,
-        c.p_this_many_below_0_05,
-        if c.least_consistent.is_empty() {
-            "-"
-        } else {
-            &c.least_consistent
-        },
-        c.smallest_p,
-        c.smallest_p_adjusted,
-        c.cells
-    );
-}
-
-fn print_throughput(report: &CalibrationReport) {
-    println!(
-        "{:.1} attempts/s on {} threads ({:.1} per core); {:.0} steps per attempt at {:.1} µs per mj_step; {:.1}% of time outside mj_step",
-        report.attempts_per_second,
-        report.threads,
-        report.attempts_per_second_per_core,
-        report.steps_per_attempt,
-        report.micros_per_step,
-        100.0 * report.overhead_share
-    );
-}
-
-/// `rate±se (published)`, marked `*` when chance alone explains the
-/// difference poorly (Fisher's exact p < 0.05).
-fn cell(rate: f64, se: f64, published: Option<f64>, p_value: Option<f64>) -> String {
-    let p = published.map_or("  -  ".into(), |p| format!("{p:.2}"));
-    let mark = if p_value.is_some_and(|p| p < 0.05) {
-        "*"
-    } else {
-        " "
-    };
-    format!("{rate:.2}±{se:.2} ({p}){mark}")
-}
-
-/// What the results are, printed with them.
-const NOTE: &str = "simulation of the user-study protocol; food properties are synthetic, \
-                    calibrated to published success rates, and the workload model is a \
-                    bundled synthetic one: these are not the paper's results";
 
 /// The study `hil demo kinova` runs: the paper's protocol, changed by
 /// `--components` and then by the flags.
@@ -489,9 +333,38 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
         },
         &mut |note| eprintln!("note: {note}"),
     )?;
-    print_result(&run.result, args.json)?;
+    if args.json {
+        print_json_with_note(&run.result)?;
+    } else {
+        emit(
+            &result_text(&run.result),
+            args.write_doc.as_deref(),
+            USER_STUDY_TITLE,
+        )?;
+    }
     if let Some(k) = run.keyframes {
         eprintln!("wrote {} keyframes to {}", k.written, k.dir.display());
+    }
+    Ok(())
+}
+
+/// Headings of the results pages `--write-doc` keeps.
+const CALIBRATION_TITLE: &str = "Kinova simulator calibration against the published success rates";
+const USER_STUDY_TITLE: &str = "The user-study protocol in the Kinova simulation";
+
+/// Prints a report and, with `--write-doc FILE`, keeps it as a results
+/// page naming this command line.
+fn emit(report: &str, write_doc: Option<&Path>, title: &str) -> Result<()> {
+    print!("{report}");
+    if let Some(path) = write_doc {
+        let command = super::command_line();
+        ResultsPage {
+            title,
+            command: &command,
+            report,
+        }
+        .write(path)?;
+        eprintln!("wrote {}", path.display());
     }
     Ok(())
 }
@@ -506,87 +379,6 @@ fn print_json_with_note(value: &impl serde::Serialize) -> Result<()> {
         "{}",
         serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
     );
-    Ok(())
-}
-
-/// `12.3 ± 0.4`, or the mean alone where one plate leaves the error undefined.
-fn pm(mean: f64, sem: Option<f64>, digits: usize) -> String {
-    match sem {
-        Some(s) => format!("{mean:.digits$} ± {s:.digits$}"),
-        None => format!("{mean:.digits$}"),
-    }
-}
-
-fn print_result(result: &UserStudyResult, json: bool) -> Result<()> {
-    if json {
-        return print_json_with_note(result);
-    }
-    let p = &result.protocol;
-    println!(
-        "User-study protocol in simulation ({}: {}; N_att = {}; {} repetitions; seed {}).",
-        p.environment,
-        p.foods.join(", "),
-        p.n_att,
-        p.repetitions,
-        p.seed
-    );
-    println!("Note: {NOTE}.");
-    println!(
-        "{:<12} {:>4} {:>4} {:>11} {:>10} {:>4}",
-        "method", "rep", "pos", "r_task_avg", "n_success", "n_q"
-    );
-    for p in &result.plates {
-        println!(
-            "{:<12} {:>4} {:>4} {:>11.3} {:>10} {:>4}",
-            p.method, p.repetition, p.position, p.r_task_avg, p.n_success, p.n_q
-        );
-    }
-    for sel in &result.selections {
-        let tried: Vec<String> = sel
-            .grid
-            .iter()
-            .zip(&sel.m_wt)
-            .zip(&sel.n_q)
-            .map(|((v, m), q)| format!("{v}: {:.3} (n_q {q:.2})", m.mean))
-            .collect();
-        println!(
-            "{} {} = {} chosen by mean M_wt({}) over {} validation plates per value: {}",
-            sel.method,
-            sel.parameter,
-            sel.chosen,
-            sel.w_task,
-            sel.plates,
-            tried.join(", ")
-        );
-    }
-    println!("\nper method (mean ± standard error over its plates):");
-    for s in &result.methods {
-        println!(
-            "{:<12} r_task_avg {}  n_success {}  n_q {}  ({} plates)",
-            s.method,
-            pm(s.r_task_avg, s.r_task_avg_sem, 3),
-            pm(s.n_success_per_plate, s.n_success_per_plate_sem, 2),
-            pm(s.n_q_per_plate, s.n_q_per_plate_sem, 2),
-            s.plates
-        );
-        let foods: Vec<String> = s
-            .n_q_by_food
-            .iter()
-            .map(|(f, q)| format!("{f} {q:.2}"))
-            .collect();
-        let attempts: Vec<String> = s
-            .n_q_by_attempt
-            .iter()
-            .enumerate()
-            .map(|(i, q)| format!("#{} {q:.2}", i + 1))
-            .collect();
-        println!(
-            "{:<12} asks per plate at {}; at attempt {}",
-            "",
-            foods.join(", "),
-            attempts.join(", ")
-        );
-    }
     Ok(())
 }
 
@@ -619,73 +411,9 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
     if args.json {
         return print_json_with_note(&over);
     }
-    print_over_seeds(&over);
-    Ok(())
-}
-
-/// The study over seeds as text.
-fn print_over_seeds(over: &UserStudyOverSeeds) {
-    let (seeds, rows) = (&over.seeds, &over.methods);
-    let first = seeds[0];
-    let p = &over.protocol;
-    println!(
-        "User-study protocol in simulation over {} seeds ({}..={}): {}: {}; N_att = {}; {} repetitions per seed.",
-        seeds.len(),
-        first,
-        first + seeds.len() as u64 - 1,
-        p.environment,
-        p.foods.join(", "),
-        p.n_att,
-        p.repetitions
-    );
-    println!("Note: {NOTE}.");
-    println!(
-        "per method: mean ± standard error over seeds (each seed's mean over its plates); paper's real study in brackets"
-    );
-    for row in rows {
-        let paper = row.paper.map_or(String::new(), |p| {
-            format!(" [{:.2} / {:.2} / {:.2}]", p[0], p[1], p[2])
-        });
-        let (r, s, q) = (row.r_task_avg, row.n_success_per_plate, row.n_q_per_plate);
-        println!(
-            "{:<12} r_task_avg {}  n_success {}  n_q {}{paper}",
-            row.method,
-            pm(r.mean, r.sem(), 3),
-            pm(s.mean, s.sem(), 2),
-            pm(q.mean, q.sem(), 2)
-        );
-    }
-    println!("where each method asks: queries per plate at each food, and at each attempt index");
-    for row in rows {
-        let foods: Vec<String> = row
-            .n_q_per_plate_by_food
-            .iter()
-            .map(|(f, m)| format!("{f} {}", pm(m.mean, m.sem(), 2)))
-            .collect();
-        let attempts: Vec<String> = row
-            .n_q_per_plate_by_attempt
-            .iter()
-            .enumerate()
-            .map(|(i, m)| format!("#{} {}", i + 1, pm(m.mean, m.sem(), 2)))
-            .collect();
-        println!(
-            "{:<12} {}; attempt {}",
-            row.method,
-            foods.join(", "),
-            attempts.join(", ")
-        );
-    }
-    for c in over.chosen() {
-        println!(
-            "{} {} chosen on validation (highest mean M_wt) per seed: {} (mean {})",
-            c.method,
-            c.parameter,
-            c.values
-                .iter()
-                .map(|v| v.to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-            pm(c.mean.mean, c.mean.sem(), 2)
-        );
-    }
+    emit(
+        &over_seeds_text(&over),
+        args.write_doc.as_deref(),
+        USER_STUDY_TITLE,
+    )
 }

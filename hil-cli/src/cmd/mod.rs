@@ -32,3 +32,27 @@ impl Threads {
         hil_jobs::Runner::new(self.threads)
     }
 }
+
+/// This run's command line as a person would type it (`hil` and the
+/// arguments, shell-quoted where needed), for results pages to name the
+/// command that wrote them.
+pub fn command_line() -> String {
+    let quote = |a: String| {
+        let plain = !a.is_empty()
+            && a.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_./=,:+@".contains(c));
+        if plain {
+            a
+        } else {
+            format!("'{}'", a.replace('\'', r"'\''"))
+        }
+    };
+    std::iter::once("hil".to_string())
+        .chain(
+            std::env::args_os()
+                .skip(1)
+                .map(|a| quote(a.to_string_lossy().into_owned())),
+        )
+        .collect::<Vec<_>>()
+        .join(" ")
+}

@@ -54,6 +54,7 @@ mod config;
 mod keyframes;
 mod run;
 mod seeds;
+pub mod text;
 
 pub use config::{PAPER_WORKLOAD, UserStudyConfig, Validation};
 #[cfg(feature = "physics")]

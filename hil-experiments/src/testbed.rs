@@ -835,16 +835,26 @@ impl Protocol {
     }
 
     /// `e`, raised by run `key`, naming the run: a component's failure
-    /// (a backend or query channel, e.g. a Python component's exception)
-    /// keeps its kind and source; anything else becomes a protocol state
-    /// error.
+    /// (a backend or query channel, e.g. a Python component's exception, or
+    /// a refused input) keeps its kind and source; anything else becomes a
+    /// protocol state error.
     fn in_run(&self, key: &RunKey, e: HilError) -> HilError {
         let m = &self.settings.methods[key.method];
+        let point = key.point.as_ref().map_or(String::new(), |(name, value)| {
+            format!(" at {name} = {value}")
+        });
         let run = format!(
-            "run of `{}` {:?} ({:?}, seed {}, policy seed {})",
-            m.label, key.point, key.phase, key.seed, key.policy_seed
+            "run of `{}`{point} ({:?}, seed {}, policy seed {})",
+            m.label, key.phase, key.seed, key.policy_seed
         );
         match e {
+            // Structured refusals (e.g. a policy's arm out of range): the
+            // kind and its fields are what callers match.
+            e @ (HilError::ArmOutOfRange { .. } | HilError::DimensionMismatch { .. }) => e,
+            HilError::InvalidInput { what, why } => HilError::InvalidInput {
+                what,
+                why: format!("{why} (in the {run})"),
+            },
             HilError::Backend {
                 backend,
                 why,

@@ -43,6 +43,12 @@ impl Default for Runner {
     }
 }
 
+/// The stack of a runner's worker thread: a main thread's (8 MiB), not
+/// rayon's default 2 MiB, because jobs run components written elsewhere
+/// (Python ones, with NumPy, whose threaded OpenBLAS keeps per-thread tables
+/// on the calling thread's stack and overflows 2 MiB).
+pub const WORKER_STACK_BYTES: usize = 8 << 20;
+
 impl Runner {
     /// A runner on `threads` workers; 0 means rayon's default pool
     /// (`RAYON_NUM_THREADS`, else one worker per core).
@@ -58,6 +64,7 @@ impl Runner {
         }
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
+            .stack_size(WORKER_STACK_BYTES)
             .build()
             .map_err(|e| HilError::state("thread pool", e.to_string()))?;
         Ok(Self {

@@ -23,7 +23,9 @@ use serde_json::Value;
 
 use crate::convert::{from_py, to_py};
 use crate::errors::{IntoPy, to_py_err};
-use crate::pycomponents::{PyChannel, PyEnvironment, PyPolicy, PyWorkload};
+use crate::pycomponents::{
+    PyChannel, PyEnvironment, PyPolicy, PyWorkload, environment_facts, policy_facts,
+};
 
 /// A component table (`{"type": ..., **params}`) from a type name and
 /// keyword parameters.
@@ -361,19 +363,19 @@ impl PyPolicyHandle {
     /// (default the policy's) given the queries asked at `query_times`
     /// (default those it asked through `act`). Nothing is recorded: use
     /// `act` for a policy that acts on its own.
-    #[pyo3(signature = (context, t=1, *, item_index=0, items_seen=0, attempt=0, workload=None, wl0=None, query_times=None))]
+    #[pyo3(signature = (context, t=1, *, workload=None, wl0=None, query_times=None, item_index=0, items_seen=0, attempt=0))]
     #[allow(clippy::too_many_arguments)]
     fn decide(
         &self,
         py: Python<'_>,
         context: &Bound<'_, PyArray1<f64>>,
         t: u64,
-        item_index: usize,
-        items_seen: usize,
-        attempt: u32,
         workload: Option<&Bound<'_, PyWorkloadHandle>>,
         wl0: Option<f64>,
         query_times: Option<Vec<u64>>,
+        item_index: usize,
+        items_seen: usize,
+        attempt: u32,
     ) -> PyResult<Py<PyAny>> {
         let x = self.context(context)?;
         let given = query_times.map(|q| history_of(&q)).transpose()?;
@@ -476,20 +478,18 @@ impl PyPolicyHandle {
 
     /// The diagnostics of a decision for `context` as a dict (per-arm
     /// estimate, bonus and UCB; gap, threshold, query probability and
-    /// workload forecast where the policy computes them). It decides to
-    /// get them, so a stochastic policy's random stream advances.
-    #[pyo3(signature = (context, t=1, *, workload=None, wl0=None, query_times=None))]
+    /// workload forecast where the policy computes them): `decide`'s, with
+    /// the same arguments. It decides to get them, so a stochastic
+    /// policy's random stream advances.
+    #[pyo3(signature = (context, t=1, **decide_args))]
     fn diagnostics(
-        &self,
-        py: Python<'_>,
+        slf: &Bound<'_, Self>,
         context: &Bound<'_, PyArray1<f64>>,
         t: u64,
-        workload: Option<&Bound<'_, PyWorkloadHandle>>,
-        wl0: Option<f64>,
-        query_times: Option<Vec<u64>>,
+        decide_args: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Py<PyAny>> {
-        let d = self.decide(py, context, t, 0, 0, 0, workload, wl0, query_times)?;
-        Ok(d.bind(py).get_item("diagnostics")?.unbind())
+        let d = slf.call_method("decide", (context, t), decide_args)?;
+        Ok(d.get_item("diagnostics")?.unbind())
     }
 
     fn __repr__(&self) -> String {
@@ -530,15 +530,7 @@ impl SharedPolicy {
 }
 
 impl Policy for SharedPolicy {
-    fn name(&self) -> &str {
-        &self.name
-    }
-    fn n_arms(&self) -> usize {
-        self.n_arms
-    }
-    fn dim(&self) -> usize {
-        self.dim
-    }
+    policy_facts!();
     fn seed(&mut self, seed: u64) {
         self.state().policy.seed(seed)
     }
@@ -681,15 +673,7 @@ struct SharedEnvironment {
 }
 
 impl Environment for SharedEnvironment {
-    fn name(&self) -> &str {
-        &self.name
-    }
-    fn action_space(&self) -> &ActionSpace {
-        &self.actions
-    }
-    fn context_dim(&self) -> usize {
-        self.dim
-    }
+    environment_facts!();
     fn reset(&mut self, seed: u64) -> Result<()> {
         self.item = None;
         lock(&self.inner).reset(seed)
@@ -707,9 +691,6 @@ impl Environment for SharedEnvironment {
     }
     fn best_action(&self) -> Option<ArmId> {
         lock(&self.inner).best_action()
-    }
-    fn current_item(&self) -> Option<&Item> {
-        self.item.as_ref()
     }
 }
 
@@ -1001,7 +982,18 @@ pub(crate) fn workload_arg(obj: &Bound<'_, PyAny>) -> PyResult<Arc<dyn WorkloadM
     Ok(Arc::new(PyWorkload::new(obj.py(), obj.clone().unbind())))
 }
 
+/// The serde form of a query kind (`{"response": ..., "difficulty": ...,
+/// "distraction": ...}`) from its spelling `response/difficulty/distraction`
+/// (`"mcq"`, `"open_ended/hard"`; parts left out take the default); an
+/// unknown word raises `InvalidParameterError` naming it.
+#[pyfunction]
+fn query_kind(py: Python<'_>, kind: &str) -> PyResult<Py<PyAny>> {
+    let kind: QueryKind = kind.parse().py_err()?;
+    to_py(py, &kind, "query kind")
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(query_kind, m)?)?;
     m.add_class::<PyPolicyHandle>()?;
     m.add_class::<PyEnvironmentHandle>()?;
     m.add_class::<PyChannelHandle>()?;

@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyModule;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
+use serde_json::Value;
 
 use crate::errors::IntoPy;
 
@@ -25,13 +26,78 @@ pub(crate) fn to_py<T: Serialize + ?Sized>(
     Ok(json.call_method1("loads", (text,))?.unbind())
 }
 
-/// Plain Python data (anything `json.dumps` accepts) as a `T`, through its
-/// serde form; an error names `what`.
+/// Plain Python data (dicts, lists, tuples, numbers, str, None, NumPy
+/// scalars and arrays) as a `T`, through its serde form; an error names
+/// `what` (and the key at fault, see [`to_value`]).
 pub(crate) fn from_py<T: DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<T> {
-    let text = json_text(obj)?;
-    serde_json::from_str(&text)
+    serde_json::from_value(to_value(obj, what)?)
         .map_err(|e| HilError::serde(what, e))
         .py_err()
+}
+
+/// Plain Python data as a JSON value, exactly: every int that JSON's
+/// numbers hold (i64 or u64) stays that int, and anything that would not
+/// come back as it went in (an int of more bits, e.g. a NumPy PCG64
+/// state, or a NaN / infinite float) is refused with an error naming its
+/// key (`what.key[2].key`), never turned silently into a float.
+pub(crate) fn to_value(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Value> {
+    use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+    let refuse = |why: String| Err(crate::errors::to_py_err(HilError::invalid_input(what, why)));
+    if obj.is_none() {
+        return Ok(Value::Null);
+    }
+    if obj.is_instance_of::<PyBool>() {
+        return Ok(Value::Bool(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyInt>() {
+        if let Ok(i) = obj.extract::<i64>() {
+            return Ok(i.into());
+        }
+        if let Ok(u) = obj.extract::<u64>() {
+            return Ok(u.into());
+        }
+        return refuse(format!(
+            "the int {obj} has more than 64 bits, which hil's JSON cannot hold exactly; \
+             store it as a string (str(n)) and convert it back (int(s))"
+        ));
+    }
+    if obj.is_instance_of::<PyFloat>() {
+        let x: f64 = obj.extract()?;
+        return match serde_json::Number::from_f64(x) {
+            Some(n) => Ok(Value::Number(n)),
+            None => refuse(format!("{x} is not a finite number")),
+        };
+    }
+    if let Ok(s) = obj.cast::<PyString>() {
+        return Ok(Value::String(s.to_cow()?.into_owned()));
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut map = serde_json::Map::new();
+        for (k, v) in d.iter() {
+            let Ok(key) = k.extract::<String>() else {
+                return refuse(format!("the key {k} is not a str (JSON keys are strings)"));
+            };
+            let value = to_value(&v, &format!("{what}.{key}"))?;
+            map.insert(key, value);
+        }
+        return Ok(Value::Object(map));
+    }
+    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
+        let items = obj
+            .try_iter()?
+            .enumerate()
+            .map(|(i, v)| to_value(&v?, &format!("{what}[{i}]")))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(Value::Array(items));
+    }
+    // NumPy scalars and arrays: through their Python form.
+    if obj.hasattr("tolist")? {
+        return to_value(&obj.call_method0("tolist")?, what);
+    }
+    refuse(format!(
+        "a {} is not plain data (use None, bool, int, float, str, list or dict)",
+        obj.get_type().name()?
+    ))
 }
 
 /// `value` as JSON text (what crosses to Python as a plain string, e.g.
@@ -47,12 +113,6 @@ pub(crate) fn from_json<T: DeserializeOwned>(what: &str, json: &str) -> PyResult
     serde_json::from_str(json)
         .map_err(|e| HilError::serde(what, e))
         .py_err()
-}
-
-/// `json.dumps(obj)`.
-pub(crate) fn json_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
-    let json = PyModule::import(obj.py(), "json")?;
-    json.call_method1("dumps", (obj,))?.extract()
 }
 
 /// A context from a 1-d float64 array: one copy, straight into the
@@ -100,6 +160,23 @@ pub(crate) fn array<'py>(py: Python<'py>, context: &Context) -> Bound<'py, PyArr
 /// read in (unlike JSON, TOML holds NaN and infinities, so a bad float
 /// reaches the parameter's own validation and its error names it).
 pub(crate) fn to_toml(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<toml::Value> {
+    toml_of(obj, what, false)
+}
+
+/// Plain Python data that may hold NaN or infinities (a Python policy's
+/// decision and diagnostics) as a value serde reads a `T` from: through
+/// TOML's data model, which keeps non-finite floats intact, so they reach
+/// the check that names them (the session's, or the conformance suite's
+/// `finite diagnostics`) instead of failing as unparsable JSON. A dict
+/// entry that is None is left out (an absent `Option` field is None).
+pub(crate) fn from_py_data<T: DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<T> {
+    T::deserialize(toml_of(obj, what, true)?)
+        .map_err(|e| HilError::serde(what, e.message().trim().to_string()))
+        .py_err()
+}
+
+/// [`to_toml`]; with `skip_none`, dict entries that are None are left out.
+fn toml_of(obj: &Bound<'_, PyAny>, what: &str, skip_none: bool) -> PyResult<toml::Value> {
     use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
     if obj.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(obj.extract()?));
@@ -116,8 +193,11 @@ pub(crate) fn to_toml(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<toml::Valu
     if let Ok(d) = obj.cast::<PyDict>() {
         let mut t = toml::Table::new();
         for (k, v) in d.iter() {
+            if skip_none && v.is_none() {
+                continue;
+            }
             let key: String = k.extract()?;
-            let value = to_toml(&v, &format!("{what}.{key}"))?;
+            let value = toml_of(&v, &format!("{what}.{key}"), skip_none)?;
             t.insert(key, value);
         }
         return Ok(toml::Value::Table(t));
@@ -125,13 +205,13 @@ pub(crate) fn to_toml(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<toml::Valu
     if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
         let items = obj
             .try_iter()?
-            .map(|v| to_toml(&v?, what))
+            .map(|v| toml_of(&v?, what, skip_none))
             .collect::<PyResult<Vec<_>>>()?;
         return Ok(toml::Value::Array(items));
     }
     // NumPy scalars and arrays: through their Python form.
     if obj.hasattr("tolist")? {
-        return to_toml(&obj.call_method0("tolist")?, what);
+        return toml_of(&obj.call_method0("tolist")?, what, skip_none);
     }
     Err(crate::errors::to_py_err(HilError::invalid_input(
         what,

@@ -101,7 +101,15 @@ pub(crate) fn run<T: Send>(
     let sink = Sink::of(progress, what);
     let control = Control::default();
     std::thread::scope(|scope| {
-        let handle = scope.spawn(|| work(&control));
+        // A main thread's stack for the work (which may run Python
+        // components, e.g. NumPy's threaded OpenBLAS; see
+        // `hil_jobs::WORKER_STACK_BYTES`).
+        let handle = std::thread::Builder::new()
+            .stack_size(hil_jobs::WORKER_STACK_BYTES)
+            .spawn_scoped(scope, || work(&control))
+            .map_err(|e| {
+                crate::errors::to_py_err(hil_core::HilError::state(what, e.to_string()))
+            })?;
         let mut reported = (0, 0);
         let mut raised = None;
         loop {

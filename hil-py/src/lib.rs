@@ -10,6 +10,7 @@
 //!   workload models, built from configs;
 //! - [`pycomponents`]: Python objects serving as those four traits;
 //! - [`registry`]: Python factories as named component types;
+//! - [`pretrain`]: a Python policy's pretraining on the environment's data;
 //! - [`session`]: the session loop with its record and resume;
 //! - [`reproduce`]: the paper's simulated protocol;
 //! - [`user_study`]: the paper's user-study protocol on any environment;
@@ -24,6 +25,7 @@ mod convert;
 mod errors;
 mod gym;
 mod interrupt;
+mod pretrain;
 mod pycomponents;
 mod registry;
 mod reproduce;
@@ -41,6 +43,14 @@ fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // run the Kinova environment: the `kinova` feature turns on MuJoCo
     // physics (without it the type parses but refuses to build).
     m.add("KINOVA", cfg!(feature = "kinova"))?;
+    // Python components run on the job runner's workers (rayon's global
+    // pool by default): give them a main thread's stack, as
+    // `hil_jobs::Runner::new` does, before anything starts that pool
+    // (NumPy's threaded OpenBLAS overflows rayon's default 2 MiB). If the
+    // pool exists already (a host built it), it is kept as it is.
+    let _ = rayon::ThreadPoolBuilder::new()
+        .stack_size(hil_jobs::WORKER_STACK_BYTES)
+        .build_global();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The UCB weight α of the paper's methods (hil's choice; the paper does not state it).
     m.add("PAPER_ALPHA", hil_paper::methods::ALPHA)?;

@@ -13,7 +13,7 @@
 //! (`hil-py/README.md`, "Python components inside hil", and `_hil.pyi`).
 
 use hil_core::{
-    ActionSpace, ArmId, CallOrder, Choice, Context, Decision, DecisionInput, Environment, Feedback,
+    ActionSpace, ArmId, CallOrder, Context, Decision, DecisionInput, Environment, Feedback,
     HilError, Item, Outcome, Policy, Query, QueryChannel, QueryKind, Response, Result,
     WorkloadInput, WorkloadModel,
 };
@@ -104,24 +104,53 @@ impl PyPolicy {
     }
 }
 
+/// What a Python policy's `decide` may return, for the errors that say so.
+const DECISION_FORMS: &str = "a Python policy's decide must return an arm index (an int in \
+     0..n_arms), a choice (hil.Act(arm), hil.Query(fallback, kind=...)) or a decision dict \
+     ({\"choice\": ..., \"diagnostics\": ...}); see hil-py/README.md";
+
 /// The decision a Python policy returned: an arm index, a `Choice` dict
-/// (`{"type": "act", "arm": 2}`) or a `Decision` dict.
+/// (`{"type": "act", "arm": 2}`) or a `Decision` dict, read without JSON
+/// text so that NaN or infinite diagnostics reach the checks that name
+/// them. An index of the wrong type is a `TypeError`, a negative one a
+/// `ValueError`; an arm out of range is left to the checks every policy
+/// meets (the session's `ArmOutOfRange`, the suite's `arm in range`).
 fn decision_from(value: &Bound<'_, PyAny>) -> PyResult<Decision> {
-    if let Ok(arm) = value.extract::<usize>() {
-        return Ok(Decision::act(ArmId(arm)));
-    }
-    let v: Value = from_py(value, "the decision a Python policy returned")?;
-    if v.get("choice").is_some() {
-        return serde_json::from_value(v).map_err(|e| {
-            crate::errors::to_py_err(HilError::serde("the decision a Python policy returned", e))
-        });
-    }
-    let choice: Choice = serde_json::from_value(v).map_err(|e| {
-        crate::errors::to_py_err(HilError::serde("the choice a Python policy returned", e))
-    })?;
-    Ok(Decision {
-        choice,
-        diagnostics: Default::default(),
+    use pyo3::exceptions::{PyTypeError, PyValueError};
+    use pyo3::types::{PyBool, PyDict};
+    let got = || -> PyResult<String> {
+        Ok(format!(
+            "got {} {}",
+            value.get_type().name()?,
+            value.repr()?
+        ))
+    };
+    // An int, or a NumPy integer (both have `__index__`); a bool is not an arm.
+    let is_index = !value.is_instance_of::<PyBool>() && value.hasattr("__index__")?;
+    Ok(if is_index {
+        match value.extract::<usize>() {
+            Ok(arm) => Decision::act(ArmId(arm)),
+            Err(_) => {
+                return Err(PyValueError::new_err(format!(
+                    "{DECISION_FORMS}; {}",
+                    got()?
+                )));
+            }
+        }
+    } else if let Ok(d) = value.cast::<PyDict>() {
+        if d.contains("choice")? {
+            crate::convert::from_py_data(value, "the decision a Python policy returned")?
+        } else {
+            Decision {
+                choice: crate::convert::from_py_data(value, "the choice a Python policy returned")?,
+                diagnostics: Default::default(),
+            }
+        }
+    } else {
+        return Err(PyTypeError::new_err(format!(
+            "{DECISION_FORMS}; {}",
+            got()?
+        )));
     })
 }
 
@@ -143,18 +172,36 @@ fn decision_info<'py>(py: Python<'py>, input: &DecisionInput<'_>) -> PyResult<Bo
     Ok(d)
 }
 
+impl PyPolicy {
+    /// The error of `save` or `restore` on a policy without both methods.
+    fn cannot_checkpoint(&self, operation: &str) -> HilError {
+        HilError::unsupported(
+            &self.held.label,
+            operation,
+            "it has no save() and restore() methods (give both to checkpoint its state)",
+        )
+    }
+}
+
+/// The [`Policy`] methods of a wrapper that keeps the facts (`name`,
+/// `n_arms`, `dim`) of the policy it wraps, read once.
+macro_rules! policy_facts {
+    () => {
+        fn name(&self) -> &str {
+            &self.name
+        }
+        fn n_arms(&self) -> usize {
+            self.n_arms
+        }
+        fn dim(&self) -> usize {
+            self.dim
+        }
+    };
+}
+pub(crate) use policy_facts;
+
 impl Policy for PyPolicy {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn n_arms(&self) -> usize {
-        self.n_arms
-    }
-
-    fn dim(&self) -> usize {
-        self.dim
-    }
+    policy_facts!();
 
     fn seed(&mut self, seed: u64) {
         if self.held.has("seed") {
@@ -190,23 +237,19 @@ impl Policy for PyPolicy {
     }
 
     fn save(&self) -> Result<Value> {
-        if !self.held.has("save") {
-            return Err(HilError::state(
-                &self.name,
-                "this policy cannot checkpoint its state",
-            ));
+        // Without both methods there is no checkpoint: what the trait's
+        // default says (and the conformance suite skips).
+        if !(self.held.has("save") && self.held.has("restore")) {
+            return Err(self.cannot_checkpoint("save"));
         }
         self.held.call("save", |o| {
-            from_py(&o.call_method0("save")?, "a Python policy's state")
+            crate::convert::to_value(&o.call_method0("save")?, "state")
         })
     }
 
     fn restore(&mut self, state: Value) -> Result<()> {
-        if !self.held.has("restore") {
-            return Err(HilError::state(
-                &self.name,
-                "this policy cannot restore a checkpoint",
-            ));
+        if !(self.held.has("save") && self.held.has("restore")) {
+            return Err(self.cannot_checkpoint("restore"));
         }
         self.held.call("restore", |o| {
             o.call_method1("restore", (to_py(o.py(), &state, "policy state")?,))?;
@@ -343,18 +386,29 @@ impl PyEnvironment {
     }
 }
 
+/// The [`Environment`] methods of a wrapper that keeps the facts of the
+/// environment it wraps (`name`, `actions`, `dim`) and the current `item`
+/// (what a wrapped environment behind a lock or in Python cannot lend).
+macro_rules! environment_facts {
+    () => {
+        fn name(&self) -> &str {
+            &self.name
+        }
+        fn action_space(&self) -> &ActionSpace {
+            &self.actions
+        }
+        fn context_dim(&self) -> usize {
+            self.dim
+        }
+        fn current_item(&self) -> Option<&Item> {
+            self.item.as_ref()
+        }
+    };
+}
+pub(crate) use environment_facts;
+
 impl Environment for PyEnvironment {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn action_space(&self) -> &ActionSpace {
-        &self.actions
-    }
-
-    fn context_dim(&self) -> usize {
-        self.dim
-    }
+    environment_facts!();
 
     fn reset(&mut self, seed: u64) -> Result<()> {
         self.item = None;
@@ -419,9 +473,5 @@ impl Environment for PyEnvironment {
             .ok()
             .flatten()
             .map(ArmId)
-    }
-
-    fn current_item(&self) -> Option<&Item> {
-        self.item.as_ref()
     }
 }

@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 
 use hil_config::{BuildContext, TaskContext};
 use hil_core::{HilError, Result};
-use hil_plugin::{ComponentKind, Params};
+use hil_plugin::ComponentKind;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde_json::Value;
@@ -40,17 +40,17 @@ fn factory(kind: ComponentKind, name: &str) -> Result<Py<PyAny>> {
     .ok_or_else(|| HilError::state("python registry", format!("no {kind} `{name}`")))
 }
 
-/// Calls the Python factory of (`kind`, `name`) with `params` and the
-/// build facts as keyword arguments, then converts what it returns.
+/// Calls the Python factory of (`kind`, `name`) with `params` (a table,
+/// parsed) and the build facts as keyword arguments, then converts what it
+/// returns.
 fn build<T>(
     kind: ComponentKind,
     name: &str,
-    params: &Params,
+    params: Value,
     facts: impl FnOnce(&Bound<'_, PyDict>) -> PyResult<()>,
     convert: impl FnOnce(&Bound<'_, PyAny>) -> PyResult<T>,
 ) -> Result<T> {
     let f = factory(kind, name)?;
-    let params: Value = params.parse(name)?;
     let label = format!("python {kind} factory `{name}`");
     Python::attach(|py| {
         let call = || -> PyResult<T> {
@@ -105,19 +105,27 @@ pub(crate) fn register_factory(kind: ComponentKind, name: &str, factory: Py<PyAn
     let desc = "a Python component (hil-py)";
     hil_plugin::register_static(Path::new(&label), |r| match kind {
         ComponentKind::Policy => r.policy(name, desc, move |p, ctx| {
-            build(kind, &n, p, task_facts(ctx), policy_arg)
+            let (params, pretrain) = crate::pretrain::take_flag(p.parse(&n)?)?;
+            build(kind, &n, params, task_facts(ctx), |o| {
+                if pretrain {
+                    crate::pretrain::pretrain(o, ctx)?;
+                }
+                policy_arg(o)
+            })
         }),
         ComponentKind::QueryChannel => r.query_channel(name, desc, move |p, ctx| {
-            build(kind, &n, p, task_facts(ctx), |o| channel_arg(Some(o)))
+            build(kind, &n, p.parse(&n)?, task_facts(ctx), |o| {
+                channel_arg(Some(o))
+            })
         }),
         ComponentKind::Environment => r.environment(name, desc, move |p, ctx| {
-            build(kind, &n, p, base_facts(ctx), |o| {
+            build(kind, &n, p.parse(&n)?, base_facts(ctx), |o| {
                 environment_arg(o).map(|e| e.0)
             })
         }),
         ComponentKind::WorkloadModel => r.workload_model(name, desc, move |p, ctx| {
             let m: Arc<dyn hil_core::WorkloadModel> =
-                build(kind, &n, p, base_facts(ctx), workload_arg)?;
+                build(kind, &n, p.parse(&n)?, base_facts(ctx), workload_arg)?;
             Ok(Box::new(ArcWorkload(m)))
         }),
     })?;

@@ -82,8 +82,16 @@ impl PythonComponents<'_, '_> {
                     )));
                 }
                 let what = format!("extra_methods.{label}");
-                let table =
+                let mut table =
                     component_table(&spec, ComponentKind::Policy, &label, &what, None, &mut regs)?;
+                // Every method of a protocol is pretrained alike (the
+                // built-in ones by the paper's table): a Python factory
+                // too, unless its parameters say `pretrain = false`.
+                if spec.cast::<PyDict>().is_err() {
+                    table
+                        .entry(crate::pretrain::KEY)
+                        .or_insert(toml::Value::Boolean(true));
+                }
                 settings.methods.push(Method::new(&label, table));
             }
         }

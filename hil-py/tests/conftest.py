@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import json
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Dict, List, Optional
@@ -32,10 +33,47 @@ TEST_FOODS = ["banana", "carrot"]
 PRETRAIN_FOODS = ["apple", "kiwi", "celery"]
 
 
+def experiment_toml(
+    *,
+    episodes: int,
+    items_per_episode: int,
+    pretrain_foods: List[str],
+    workload: str,
+    head: str = "",
+    channel: str = "",
+) -> str:
+    """An experiment file as `hil run` reads it: LinUCB-QG (alpha 0.5,
+    w = 4, pretrained on `pretrain_foods`) on TEST_FOODS of the bundled
+    (synthetic) dataset, N_att = 10, the bundled `workload` model and the
+    simulated expert; `head` adds top-level keys, `channel` the expert's
+    parameters (TOML lines)."""
+    return f"""{head}
+episodes = {episodes}
+[session]
+n_att = 10
+[environment]
+type = "food_replay"
+foods = {json.dumps(TEST_FOODS)}
+pretrain_foods = {json.dumps(pretrain_foods)}
+items_per_episode = {items_per_episode}
+[policy]
+type = "linucb_qg"
+alpha = 0.5
+w = 4.0
+pretrain = true
+[workload]
+type = "bundled"
+name = "{workload}"
+[channel]
+type = "simulated_expert"
+{channel}
+"""
+
+
 class MeanPolicy:
     """A per-arm linear learner written in Python that asks at the
     first attempt of its first `ask_items` items (over its whole life, not
-    per episode); checkpoints its counts."""
+    per episode); pretrains like it learns; checkpoints its counts."""
 
     name = "mean_py"
 
@@ -58,6 +96,10 @@ class MeanPolicy:
     def observe(self, context: np.ndarray, arm: int, reward: float, info: Dict[str, Any]) -> None:
         self.sums[arm] += (reward - 0.5) * context
         self.counts[arm] += 1.0
+
+    def pretrain(self, contexts: np.ndarray, arms: np.ndarray, rewards: np.ndarray) -> None:
+        np.add.at(self.sums, arms, (rewards - 0.5)[:, None] * contexts)
+        np.add.at(self.counts, arms, 1.0)
 
     def save(self) -> Dict[str, List[float]]:
         return {"sums": self.sums.tolist(), "counts": self.counts.tolist(), "asked": self.asked}

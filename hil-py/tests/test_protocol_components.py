@@ -97,17 +97,6 @@ def test_a_channel_naming_a_registered_type_needs_no_python():
     assert mean(runs_of(named, "AlwaysQuery"), "r_task_avg") < 0.9
 
 
-def test_the_python_channel_passes_the_conformance_suite():
-    assert hil.testing.check_query_channel(WrongExpert)["passed"]
-
-
-def test_a_failing_python_channel_is_a_backend_error_naming_it():
-    with pytest.raises(hil.BackendError) as e:
-        hil.reproduce(small_quick(), channel=AskFails)
-    assert "wrong_expert_py" in str(e.value) and "ask" in str(e.value)
-    assert "tablet is off" in str(e.value)
-
-
 # ----------------------------------------------------------- environments
 
 
@@ -166,14 +155,28 @@ def test_a_clumsy_python_environment_lowers_success(default_run):
         assert mean(runs_of(clumsy, label), "r_task_avg") < mean(runs_of(default_run, label), "r_task_avg")
 
 
-def test_the_python_environment_passes_the_conformance_suite():
-    assert hil.testing.check_environment(ClumsyRobot)["passed"]
+@pytest.mark.parametrize(
+    "check, component",
+    [(hil.testing.check_query_channel, WrongExpert), (hil.testing.check_environment, ClumsyRobot)],
+)
+def test_the_python_channel_and_environment_pass_their_conformance_suites(check, component):
+    assert check(component)["passed"]
 
 
-def test_a_broken_python_environment_is_named():
+@pytest.mark.parametrize(
+    "argument, broken, named",
+    [
+        ("channel", AskFails, ["wrong_expert_py", "ask", "tablet is off"]),
+        ("environment", ExecuteFails, ["clumsy_robot_py", "gripper jammed"]),
+    ],
+)
+def test_a_failing_python_component_is_a_backend_error_naming_it(argument, broken, named):
     with pytest.raises(hil.BackendError) as e:
-        hil.reproduce(small_quick(), environment=ExecuteFails)
-    assert "clumsy_robot_py" in str(e.value) and "gripper jammed" in str(e.value)
+        hil.reproduce(small_quick(), **{argument: broken})
+    assert all(word in str(e.value) for word in named)
+
+
+def test_an_environment_of_the_wrong_shape_is_named():
     with pytest.raises(hil.HilError) as e:
         hil.reproduce(small_quick(), environment=WrongShape)
     assert "context dimension 3" in str(e.value)

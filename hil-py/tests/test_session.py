@@ -7,31 +7,16 @@ import numpy as np
 import pytest
 
 import hil
-from conftest import PRETRAIN_FOODS, TEST_FOODS
+from conftest import PRETRAIN_FOODS, TEST_FOODS, experiment_toml
 
-CONFIG = f"""
-seed = 5
-episodes = 3
-[session]
-n_att = 10
-wl0 = 0.5
-[environment]
-type = "food_replay"
-foods = {json.dumps(TEST_FOODS)}
-pretrain_foods = {json.dumps(PRETRAIN_FOODS)}
-items_per_episode = 4
-[policy]
-type = "linucb_qg"
-alpha = 0.5
-w = 4.0
-pretrain = true
-[workload]
-type = "bundled"
-name = "f2_sim"
-[channel]
-type = "simulated_expert"
-error_rate = 0.2
-"""
+CONFIG = experiment_toml(
+    head="seed = 5",
+    episodes=3,
+    items_per_episode=4,
+    pretrain_foods=PRETRAIN_FOODS,
+    workload="f2_sim",
+    channel="error_rate = 0.2",
+)
 
 
 @pytest.fixture

@@ -1,34 +1,19 @@
 """hil.sweep: the protocol and config grids, in-process and on a local Ray."""
 
 import json
+import re
+import sys
+from pathlib import Path
 
 import pytest
 
 import hil._hil as native
+from conftest import experiment_toml
 from hil.sweep import protocol_settings, sweep
 
 # One episode of two items on the bundled (synthetic) data, LinUCB-QG
 # pretrained on the paper's pretraining foods.
-CONFIG = """
-episodes = 1
-[session]
-n_att = 10
-[environment]
-type = "food_replay"
-foods = ["banana", "carrot"]
-pretrain_foods = ["apple", "kiwi"]
-items_per_episode = 2
-[policy]
-type = "linucb_qg"
-alpha = 0.5
-w = 4.0
-pretrain = true
-[workload]
-type = "bundled"
-name = "f12_sim"
-[channel]
-type = "simulated_expert"
-"""
+CONFIG = experiment_toml(episodes=1, items_per_episode=2, pretrain_foods=["apple", "kiwi"], workload="f12_sim")
 
 
 def small_protocol():
@@ -86,3 +71,18 @@ def test_bad_inputs_are_refused(tmp_path):
         sweep()
     with pytest.raises(ValueError):
         sweep("quick", backend="spark")
+
+
+@pytest.mark.parametrize("backend", ["auto", "ray"])
+def test_a_cluster_address_without_ray_is_an_error_not_a_local_run(monkeypatch, backend):
+    # Ray made unimportable, whether or not this environment has it.
+    monkeypatch.setitem(sys.modules, "ray", None)
+    with pytest.raises(ImportError, match="hil-py\\[ray\\]"):
+        sweep(small_protocol(), backend=backend, address="ray://head:10001")
+    with pytest.raises(ValueError):
+        sweep(small_protocol(), backend="local", address="ray://head:10001")
+
+
+def test_the_ray_extra_installs_the_client_a_ray_address_needs():
+    pyproject = (Path(__file__).resolve().parents[1] / "pyproject.toml").read_text()
+    assert re.search(r'^ray = \["ray\[client\]', pyproject, re.M)

@@ -424,7 +424,8 @@ impl Session<'_> {
         let t = episode.t;
         match decision.choice {
             Choice::Act { arm } => {
-                self.check_arm(arm, "policy decision")?;
+                // A policy's arm out of range keeps its kind (`ArmOutOfRange`).
+                self.environment.action_space().check(arm)?;
                 Ok(Decided {
                     item,
                     attempt,
@@ -437,7 +438,7 @@ impl Session<'_> {
                 })
             }
             Choice::Query { kind, fallback } => {
-                self.check_arm(fallback, "policy fallback")?;
+                self.environment.action_space().check(fallback)?;
                 let query = Query {
                     t,
                     item: item.clone(),

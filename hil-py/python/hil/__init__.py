@@ -10,9 +10,10 @@ figures; results computed from it are not the paper's results.
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 from . import testing
+from .decisions import Act, Diagnostics, Query, QueryKind
 from ._hil import (
     KINOVA,
     PAPER_ALPHA,
@@ -56,6 +57,10 @@ if _ilu.find_spec("gymnasium") is not None:
     from . import envs  # noqa: F401  (registers hil/FoodReplay-v0)
 
 __all__ = [
+    "Act",
+    "Diagnostics",
+    "Query",
+    "QueryKind",
     "protocol_settings",
     "sweep",
     "KINOVA",
@@ -98,124 +103,76 @@ __all__ = [
 ]
 
 
-def _paper_policy(
-    type_: str,
-    alpha: float,
-    lambda_: float,
-    pretrain: bool,
-    environment: Optional[Environment],
-    actions: Any,
-    dim: Optional[int],
-    pretraining: Any,
-    seed: int,
-    params: dict,
-) -> Policy:
-    params = dict(params)
-    params["lambda"] = lambda_
-    return Policy(
-        type_,
-        environment=environment,
-        actions=actions,
-        dim=dim,
-        pretraining=pretraining,
-        seed=seed,
-        alpha=alpha,
-        pretrain=pretrain,
-        **params,
-    )
+def _paper_policy(name: str, type_: str, doc: str, required: tuple = ()) -> Callable[..., Policy]:
+    """The constructor ``name`` of one of the paper's policies: ``type_``
+    built with α (default :data:`PAPER_ALPHA`), λ and the ``required``
+    parameters."""
+
+    def build(
+        *,
+        alpha: float = PAPER_ALPHA,
+        lambda_: float = 1.0,
+        pretrain: bool = False,
+        environment: Optional[Environment] = None,
+        actions: Any = None,
+        dim: Optional[int] = None,
+        pretraining: Any = None,
+        seed: int = 0,
+        **options: Any,
+    ) -> Policy:
+        missing = [name for name in required if name not in options]
+        if missing:
+            raise TypeError(f"{type_} needs the keyword argument {missing[0]!r}")
+        task = dict(environment=environment, actions=actions, dim=dim, pretraining=pretraining, seed=seed)
+        return Policy(type_, **task, alpha=alpha, pretrain=pretrain, **{"lambda": lambda_, **options})
+
+    build.__name__ = build.__qualname__ = name
+    build.__doc__ = doc
+    return build
 
 
-def LinUCB(
-    *,
-    alpha: float = PAPER_ALPHA,
-    lambda_: float = 1.0,
-    pretrain: bool = False,
-    environment: Optional[Environment] = None,
-    actions: Any = None,
-    dim: Optional[int] = None,
-    pretraining: Any = None,
-    seed: int = 0,
-    **options: Any,
-) -> Policy:
+LinUCB = _paper_policy(
+    "LinUCB",
+    "linucb",
     """LinUCB, which never asks (the paper's baseline).
 
     ``alpha`` weighs the confidence bonus, ``lambda_`` is the ridge
     strength; ``pretrain`` fits the arms first on ``environment``'s
     pretraining data or on ``pretraining=(X, arms, rewards)``. Give
     ``environment=`` or ``actions=`` (a count or names) and ``dim=``.
-    ``options`` are further config keys (e.g. ``estimator={...}``).
+    Further keyword arguments are config keys (e.g. ``estimator={...}``).
     Bad values raise :class:`InvalidParameterError` naming the parameter.
-    """
-    return _paper_policy(
-        "linucb", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options
-    )
+    """,
+)
 
-
-def AlwaysQuery(
-    *,
-    alpha: float = PAPER_ALPHA,
-    lambda_: float = 1.0,
-    pretrain: bool = False,
-    environment: Optional[Environment] = None,
-    actions: Any = None,
-    dim: Optional[int] = None,
-    pretraining: Any = None,
-    seed: int = 0,
-    **options: Any,
-) -> Policy:
+AlwaysQuery = _paper_policy(
+    "AlwaysQuery",
+    "always_query",
     """AlwaysQuery: asks at every new item (the paper's upper baseline).
 
     Parameters as :func:`LinUCB`; ``query_kind=`` sets what it asks.
-    """
-    return _paper_policy(
-        "always_query", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options
-    )
+    """,
+)
 
-
-def LinUCBExpDecay(
-    *,
-    c: float,
-    alpha: float = PAPER_ALPHA,
-    lambda_: float = 1.0,
-    pretrain: bool = False,
-    environment: Optional[Environment] = None,
-    actions: Any = None,
-    dim: Optional[int] = None,
-    pretraining: Any = None,
-    seed: int = 0,
-    **options: Any,
-) -> Policy:
+LinUCBExpDecay = _paper_policy(
+    "LinUCBExpDecay",
+    "linucb_exp_decay",
     """LinUCB-ExpDecay: asks with a probability decaying in the items seen.
 
-    ``c`` (>= 0) sets the decay; other parameters as :func:`LinUCB`.
-    """
-    options = dict(options, c=c)
-    return _paper_policy(
-        "linucb_exp_decay", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options
-    )
+    ``c=`` (required, >= 0) sets the decay; other parameters as :func:`LinUCB`.
+    """,
+    required=("c",),
+)
 
-
-def LinUCBQG(
-    *,
-    w: float,
-    alpha: float = PAPER_ALPHA,
-    lambda_: float = 1.0,
-    pretrain: bool = False,
-    environment: Optional[Environment] = None,
-    actions: Any = None,
-    dim: Optional[int] = None,
-    pretraining: Any = None,
-    seed: int = 0,
-    **options: Any,
-) -> Policy:
+LinUCBQG = _paper_policy(
+    "LinUCBQG",
+    "linucb_qg",
     """LinUCB-QG: asks when the UCB gap is below a threshold set by the
     forecast workload (the paper's method).
 
-    ``w`` (>= 0) weighs the workload; pass ``workload=`` to
+    ``w=`` (required, >= 0) weighs the workload; pass ``workload=`` to
     :meth:`Policy.decide` for the forecast. Other parameters as
     :func:`LinUCB`.
-    """
-    options = dict(options, w=w)
-    return _paper_policy(
-        "linucb_qg", alpha, lambda_, pretrain, environment, actions, dim, pretraining, seed, options
-    )
+    """,
+    required=("w",),
+)

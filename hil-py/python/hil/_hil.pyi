@@ -176,12 +176,12 @@ class Policy:
         context: npt.ArrayLike,
         t: int = 1,
         *,
-        item_index: int = 0,
-        items_seen: int = 0,
-        attempt: int = 0,
         workload: Optional[WorkloadModel] = None,
         wl0: Optional[float] = None,
         query_times: Optional[Sequence[int]] = None,
+        item_index: int = 0,
+        items_seen: int = 0,
+        attempt: int = 0,
     ) -> Dict[str, Any]: ...
     def act(
         self, context: npt.ArrayLike, t: int = 1, *, item_index: int = 0, items_seen: int = 0, attempt: int = 0
@@ -196,30 +196,17 @@ class Policy:
         """Seconds spent inside the policy's own decide and observe so far."""
     def save(self) -> str: ...
     def restore(self, state: Union[str, _Json]) -> None: ...
-    def diagnostics(
-        self,
-        context: npt.ArrayLike,
-        t: int = 1,
-        *,
-        workload: Optional[WorkloadModel] = None,
-        wl0: Optional[float] = None,
-        query_times: Optional[Sequence[int]] = None,
-    ) -> Dict[str, Any]: ...
+    def diagnostics(self, context: npt.ArrayLike, t: int = 1, **decide_args: Any) -> Dict[str, Any]:
+        """The diagnostics of `decide(context, t, **decide_args)`."""
+
+def query_kind(kind: str) -> Dict[str, str]:
+    """The serde form of a query kind from its spelling `response/difficulty/distraction`."""
 
 class QueryChannel:
-    """A hil query channel (any built-in or registered type)."""
+    """A hil query channel (any built-in or registered type), built for
+    `environment=`, or `actions=` and `dim=`, as a `Policy` is."""
 
-    def __init__(
-        self,
-        type: str,
-        /,
-        *,
-        environment: Optional[Environment] = None,
-        actions: Optional[_Actions] = None,
-        dim: Optional[int] = None,
-        seed: int = 0,
-        **params: Any,
-    ) -> None: ...
+    def __init__(self, type: str, /, *, seed: int = 0, **task_and_params: Any) -> None: ...
     @property
     def name(self) -> str: ...
     def seed(self, seed: int) -> None: ...

@@ -33,7 +33,12 @@ runs (on a worker thread) with the agent in the policy's seat. So:
 Observation
     The context of the attempt the agent decides for: ``Box(-inf, inf,
     (dim,), float64)`` (hil's contexts are float64; the food features are
-    d = 2048). After the last step the observation repeats the last context.
+    d = 2048). Unbounded on purpose: hil's contexts have no declared range
+    (the synthetic features carry Gaussian noise; a dataset from disk, the
+    Kinova scene or a plugin environment may hold any finite value), so
+    hil checks each for finiteness instead, and ``check_env`` warns about
+    the infinite bounds. After the last step the observation repeats the
+    last context.
 
 Reward
     The number of successful attempts in the step (0 or 1, since a success

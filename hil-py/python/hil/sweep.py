@@ -50,18 +50,24 @@ def protocol_settings(protocol: Settings = "paper") -> dict:
     return json.loads(_hil.protocol_settings_from_file(str(path)))
 
 
-def _ray(backend: str):
-    """Ray if the backend asks for it (or may use it), else None."""
+def _ray(backend: str, address: Optional[str] = None):
+    """Ray if the backend asks for it (or may use it), else None. A cluster
+    ``address`` asks for Ray: without it installed that is an error, never
+    a silent run in this process."""
     if backend not in ("auto", "ray", "local"):
         raise ValueError(f"backend must be 'auto', 'ray' or 'local', got {backend!r}")
     if backend == "local":
+        if address is not None:
+            raise ValueError(f"address={address!r} is a Ray cluster's: it needs backend 'ray' or 'auto'")
         return None
     try:
         import ray
     except ImportError:
-        if backend == "ray":
+        if backend == "ray" or address is not None:
+            wanted = "backend='ray'" if address is None else f"address={address!r}"
             raise ImportError(
-                "backend='ray' needs Ray: pip install './hil-py[ray]'"
+                f"{wanted} needs Ray (with its client for a ray:// address): "
+                "pip install './hil-py[ray]'"
             ) from None
         return None
     return ray
@@ -130,8 +136,10 @@ def sweep(
         seeds: the master seeds of the config grid.
         backend: ``"auto"`` (Ray if installed, else in-process), ``"ray"``
             or ``"local"`` (in this process; the protocol uses every core).
-        address: a Ray cluster's address; None starts (or reuses) a local
-            Ray with ``num_cpus`` CPUs (default: this machine's count).
+        address: a Ray cluster's address (e.g. ``"ray://head:10001"``);
+            without Ray installed it raises ``ImportError``, never runs in
+            process. None starts (or reuses) a local Ray with ``num_cpus``
+            CPUs (default: this machine's count).
             A Ray started here is left running for later sweeps
             (``ray.shutdown()`` stops it).
         num_cpus: CPUs of a local Ray.
@@ -165,7 +173,7 @@ def sweep(
     """
     if (protocol is None) == (configs is None):
         raise ValueError("give either protocol or configs (with seeds)")
-    ray = _ray(backend)
+    ray = _ray(backend, address)
     if ray is not None:
         _start_ray(ray, address, num_cpus)
     if protocol is not None:

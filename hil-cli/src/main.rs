@@ -1,6 +1,7 @@
 //! `hil`: run human-in-the-loop contextual-bandit experiments.
 
 mod cmd;
+mod out;
 
 use std::process::ExitCode;
 
@@ -57,8 +58,11 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // A reader that has gone (`hil data check DIR | head -3`) is no
+        // error of ours: end quietly, as a program that SIGPIPE ends.
+        Err(e) if out::is_closed_stdout(&e) => ExitCode::from(out::CLOSED_STDOUT_STATUS),
         Err(e) => {
-            eprintln!("error: {e}");
+            out::note!("error: {e}");
             ExitCode::FAILURE
         }
     }

@@ -272,7 +272,7 @@ pub fn pretraining_data(
     reward: PretrainReward,
     seed: u64,
 ) -> Result<Vec<LabelledObservation>> {
-    check_disjoint(&[("pretrain", foods)], ds)?;
+    check_disjoint(&[("pretrain_foods", foods)], ds)?;
     let mut rng = ChaCha8Rng::seed_from_u64(splitmix(seed, 77));
     let mut out = Vec::new();
     for name in foods {
@@ -361,12 +361,16 @@ fn check_items(items_per_episode: usize) -> Result<()> {
 impl FoodReplayConfig {
     fn dataset(&self, ctx: &BuildContext) -> Result<Arc<FoodDataset>> {
         let ds = match &self.dataset {
-            Some(p) => Arc::new(FoodDataset::load(&ctx.resolve(p))?),
+            // Named as the config's `dataset` key, so that the error says
+            // which config pointed at the file.
+            Some(p) => Arc::new(FoodDataset::load(&ctx.resolve(p)).map_err(|e| {
+                HilError::invalid_parameter("dataset", p.display(), format!("cannot be used: {e}"))
+            })?),
             None => crate::bundled_dataset()?,
         };
-        let mut sets: Vec<(&str, &[String])> = vec![("environment.foods", &self.foods)];
+        let mut sets: Vec<(&str, &[String])> = vec![("foods", &self.foods)];
         if !self.pretrain_foods.is_empty() {
-            sets.push(("environment.pretrain_foods", &self.pretrain_foods));
+            sets.push(("pretrain_foods", &self.pretrain_foods));
         }
         check_disjoint(&sets, &ds)?;
         Ok(ds)

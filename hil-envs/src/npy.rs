@@ -3,7 +3,13 @@
 //! the dataset's arrays.
 //!
 //! Supported element types on read: little-endian `f8`, `f4`, `i8`, `i4`,
-//! `u1` and `b1` (all returned as `f64`); C order only. Files are always
+//! `u1` and `b1` (all returned as `f64`), in any spelling `numpy.dtype`
+//! accepts (`float64`, `d`, ...); C order only. The header is read as
+//! `numpy.load` reads it (checked against numpy 2.4): a dict literal with
+//! exactly the keys `descr`, `fortran_order` and `shape` (a repeated key
+//! keeps its last value; any other key is refused). This small reader is
+//! kept rather than the `npyz` crate because the limits below (size checked
+//! before any allocation, errors naming the header field) are its point. Files are always
 //! written as version 1.0, little-endian `f8`, C order.
 //!
 //! Limits: a file holds at most [`hil_core::files::limits::ARRAY`] bytes
@@ -71,14 +77,23 @@ enum Dtype {
 }
 
 impl Dtype {
+    /// The element type of a `descr`, in every spelling `numpy.dtype`
+    /// accepts for it: a byte-order mark (`<`, or `=` / `|` / none for
+    /// the native order, little-endian on every platform hil builds for)
+    /// and a type code (`f8`, `float64`, `d`, `float`, ...). Big-endian
+    /// (`>`) is not supported.
     fn parse(descr: &str) -> Option<Self> {
-        Some(match descr {
-            "<f8" => Self::F8,
-            "<f4" => Self::F4,
-            "<i8" => Self::I8,
-            "<i4" => Self::I4,
-            "|u1" | "<u1" => Self::U1,
-            "|b1" => Self::B1,
+        let code = match descr.as_bytes().first()? {
+            b'<' | b'=' | b'|' => &descr[1..],
+            _ => descr,
+        };
+        Some(match code {
+            "f8" | "float64" | "d" | "float" | "double" => Self::F8,
+            "f4" | "float32" | "f" | "single" => Self::F4,
+            "i8" | "int64" | "q" | "longlong" => Self::I8,
+            "i4" | "int32" | "i" | "intc" => Self::I4,
+            "u1" | "uint8" | "B" | "ubyte" => Self::U1,
+            "b1" | "bool" | "?" => Self::B1,
             _ => return None,
         })
     }
@@ -148,9 +163,8 @@ pub fn read_npy_bytes(bytes: &[u8], path: &Path) -> Result<NpyArray> {
         .ok_or_else(|| bad(path, "header", "header runs past the end of the file"))?;
     let header = std::str::from_utf8(&bytes[start..end])
         .map_err(|_| bad(path, "header", "header is not text"))?;
-    let descr =
-        dict_value(header, "descr").ok_or_else(|| bad(path, "descr", "header has no `descr`"))?;
-    let descr = descr.trim().trim_matches(|c| c == '\'' || c == '"');
+    let header = Header::parse(header).map_err(|why| bad(path, "header", why))?;
+    let descr = header.descr.as_str();
     let dtype = Dtype::parse(descr).ok_or_else(|| {
         bad(
             path,
@@ -158,29 +172,14 @@ pub fn read_npy_bytes(bytes: &[u8], path: &Path) -> Result<NpyArray> {
             format!("unsupported element type `{descr}` (use <f8, <f4, <i8, <i4, u1 or b1)"),
         )
     })?;
-    let fortran = dict_value(header, "fortran_order")
-        .ok_or_else(|| bad(path, "fortran_order", "header has no `fortran_order`"))?;
-    if fortran.trim() != "False" {
+    if header.fortran_order {
         return Err(bad(
             path,
             "fortran_order",
             "Fortran-ordered arrays are not supported; save with np.ascontiguousarray",
         ));
     }
-    let shape_txt =
-        dict_value(header, "shape").ok_or_else(|| bad(path, "shape", "header has no `shape`"))?;
-    let inner = shape_txt
-        .trim()
-        .strip_prefix('(')
-        .and_then(|s| s.strip_suffix(')'))
-        .ok_or_else(|| bad(path, "shape", format!("`{shape_txt}` is not a tuple")))?;
-    let mut shape = Vec::new();
-    for part in inner.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        shape.push(
-            part.parse::<usize>()
-                .map_err(|_| bad(path, "shape", format!("`{part}` is not a dimension")))?,
-        );
-    }
+    let shape = header.shape;
     let n = shape
         .iter()
         .try_fold(1usize, |acc, &d| acc.checked_mul(d))
@@ -213,26 +212,164 @@ pub fn read_npy_bytes(bytes: &[u8], path: &Path) -> Result<NpyArray> {
     Ok(NpyArray { shape, data })
 }
 
-/// The text of `key`'s value in a Python dict literal (the `.npy` header).
-fn dict_value<'a>(header: &'a str, key: &str) -> Option<&'a str> {
-    let pat_single = format!("'{key}'");
-    let pat_double = format!("\"{key}\"");
-    let at = header
-        .find(&pat_single)
-        .map(|i| i + pat_single.len())
-        .or_else(|| header.find(&pat_double).map(|i| i + pat_double.len()))?;
-    let rest = header[at..].trim_start().strip_prefix(':')?;
-    // The value ends at the first comma outside parentheses.
-    let mut depth = 0i32;
-    for (i, c) in rest.char_indices() {
-        match c {
-            '(' => depth += 1,
-            ')' => depth -= 1,
-            ',' | '}' if depth == 0 => return Some(&rest[..i]),
-            _ => {}
+/// The `.npy` header: a Python dict literal with exactly the keys `descr`,
+/// `fortran_order` and `shape`, read as numpy reads it (a literal parse,
+/// where a key given twice keeps its last value, and any other key is
+/// refused, as numpy's "Header does not contain the correct keys").
+#[derive(Debug, PartialEq)]
+struct Header {
+    descr: String,
+    fortran_order: bool,
+    shape: Vec<usize>,
+}
+
+/// A value in the header's dict literal.
+#[derive(Debug)]
+enum Literal {
+    Str(String),
+    Bool(bool),
+    Tuple(Vec<usize>),
+    /// Any other value (kept as text for the error).
+    Other(String),
+}
+
+impl std::fmt::Display for Literal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Str(s) => write!(f, "'{s}'"),
+            Self::Bool(b) => f.write_str(if *b { "True" } else { "False" }),
+            Self::Tuple(t) => write!(f, "{t:?}"),
+            Self::Other(text) => f.write_str(&hil_core::error::echo(text)),
         }
     }
-    None
+}
+
+impl Header {
+    fn parse(text: &str) -> std::result::Result<Self, String> {
+        let mut p = LiteralParser { rest: text };
+        let mut descr = None;
+        let mut fortran_order = None;
+        let mut shape = None;
+        p.expect('{')?;
+        loop {
+            if p.eat('}') {
+                break;
+            }
+            let key = match p.value()? {
+                Literal::Str(k) => k,
+                other => return Err(format!("a key is not a string: {other}")),
+            };
+            p.expect(':')?;
+            let value = p.value()?;
+            match key.as_str() {
+                "descr" => descr = Some(value),
+                "fortran_order" => fortran_order = Some(value),
+                "shape" => shape = Some(value),
+                other => {
+                    return Err(format!(
+                        "unexpected key `{other}` (the header has exactly `descr`, `fortran_order` and `shape`)"
+                    ));
+                }
+            }
+            if !p.eat(',') {
+                p.expect('}')?;
+                break;
+            }
+        }
+        if !p.rest.trim().is_empty() {
+            return Err(format!("text after the dict: `{}`", p.rest.trim()));
+        }
+        let missing = |k: &str| format!("no `{k}` key");
+        Ok(Self {
+            descr: match descr.ok_or_else(|| missing("descr"))? {
+                Literal::Str(d) => d,
+                other => return Err(format!("`descr` {other} is not a string")),
+            },
+            fortran_order: match fortran_order.ok_or_else(|| missing("fortran_order"))? {
+                Literal::Bool(b) => b,
+                other => return Err(format!("`fortran_order` {other} is not True or False")),
+            },
+            shape: match shape.ok_or_else(|| missing("shape"))? {
+                Literal::Tuple(s) => s,
+                other => return Err(format!("`shape` {other} is not a tuple of sizes")),
+            },
+        })
+    }
+}
+
+/// Reads the few Python literals a `.npy` header holds.
+struct LiteralParser<'a> {
+    rest: &'a str,
+}
+
+impl LiteralParser<'_> {
+    fn eat(&mut self, c: char) -> bool {
+        self.rest = self.rest.trim_start();
+        match self.rest.strip_prefix(c) {
+            Some(r) => {
+                self.rest = r;
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn expect(&mut self, c: char) -> std::result::Result<(), String> {
+        if self.eat(c) {
+            Ok(())
+        } else {
+            Err(format!(
+                "expected `{c}` at `{}`",
+                hil_core::error::echo(self.rest)
+            ))
+        }
+    }
+
+    fn value(&mut self) -> std::result::Result<Literal, String> {
+        self.rest = self.rest.trim_start();
+        let quote = self.rest.chars().next().ok_or("the header ends early")?;
+        if quote == '\'' || quote == '"' {
+            let body = &self.rest[1..];
+            let end = body.find(quote).ok_or("a string is not closed")?;
+            let s = &body[..end];
+            if s.contains('\\') {
+                return Err(format!("escapes are not supported in `{s}`"));
+            }
+            self.rest = &body[end + 1..];
+            return Ok(Literal::Str(s.to_string()));
+        }
+        if self.eat('(') {
+            let mut dims = Vec::new();
+            loop {
+                if self.eat(')') {
+                    return Ok(Literal::Tuple(dims));
+                }
+                let digits = self.rest.len()
+                    - self
+                        .rest
+                        .trim_start_matches(|c: char| c.is_ascii_digit())
+                        .len();
+                let (n, rest) = self.rest.split_at(digits);
+                dims.push(n.parse::<usize>().map_err(|_| {
+                    format!("`{}` is not a size", hil_core::error::echo(self.rest))
+                })?);
+                self.rest = rest;
+                if !self.eat(',') {
+                    self.expect(')')?;
+                    return Ok(Literal::Tuple(dims));
+                }
+            }
+        }
+        // A bare word or number: up to the next separator.
+        let end = self.rest.find([',', '}', ':']).unwrap_or(self.rest.len());
+        let (word, rest) = self.rest.split_at(end);
+        self.rest = rest;
+        Ok(match word.trim() {
+            "True" => Literal::Bool(true),
+            "False" => Literal::Bool(false),
+            other => Literal::Other(other.to_string()),
+        })
+    }
 }
 
 /// Encodes an array as `.npy` version 1.0, little-endian `f8`, C order.
@@ -340,6 +477,54 @@ mod tests {
                 other => panic!("{other:?}"),
             }
         }
+    }
+
+    /// A file of two `f8` values, 1.5 and -2.0, under `header`.
+    fn with_header(header: &str) -> Vec<u8> {
+        let mut h = header.to_string();
+        h.push_str(&" ".repeat((64 - (10 + h.len() + 1) % 64) % 64));
+        h.push('\n');
+        let mut b = b"\x93NUMPY\x01\x00".to_vec();
+        b.extend_from_slice(&(h.len() as u16).to_le_bytes());
+        b.extend_from_slice(h.as_bytes());
+        for v in [1.5f64, -2.0] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b
+    }
+
+    /// What `numpy.load` (2.4) does with each header, checked with numpy:
+    /// other spellings of the element type and a repeated key (the last
+    /// one counts) load; an extra key, a non-bool order or a list shape
+    /// are refused.
+    #[test]
+    fn headers_are_read_as_numpy_reads_them() {
+        for h in [
+            "{'descr': 'float64', 'fortran_order': False, 'shape': (2,), }",
+            "{'descr': 'f8', 'fortran_order': False, 'shape': (2,)}",
+            "{'descr': '=d', 'fortran_order': False, 'shape': (2,)}",
+            "{\"descr\": \"<f8\", 'fortran_order': False, 'shape': (2,)}",
+            "{'descr': '<f8', 'fortran_order': False, 'shape': (3,), 'shape': (2,), }",
+        ] {
+            let a = read_npy_bytes(&with_header(h), p()).unwrap_or_else(|e| panic!("{h}: {e}"));
+            assert_eq!((a.shape, a.data), (vec![2], vec![1.5, -2.0]), "{h}");
+        }
+        for h in [
+            "{'descr': '<f8', 'fortran_order': False, 'shape': (2,), 'extra': 1, }",
+            "{'descr': '<f8', 'fortran_order': 0, 'shape': (2,)}",
+            "{'descr': '<f8', 'fortran_order': False, 'shape': [2]}",
+            "{'descr': '<f8', 'fortran_order': False}",
+            "{'descr': '<f8', 'fortran_order': False, 'shape': (2,)} x",
+        ] {
+            match read_npy_bytes(&with_header(h), p()) {
+                Err(HilError::Data { field, .. }) => assert_eq!(field, "header", "{h}"),
+                other => panic!("{h}: {other:?}"),
+            }
+        }
+        let big = with_header("{'descr': '>f8', 'fortran_order': False, 'shape': (2,)}");
+        assert!(
+            matches!(read_npy_bytes(&big, p()), Err(HilError::Data { field, .. }) if field == "descr")
+        );
     }
 
     #[test]

@@ -51,25 +51,27 @@ impl FoodSplit {
     /// Checks that every set is non-empty, every food exists in `ds`, and no
     /// food is listed twice (within or across sets).
     pub fn validate(&self, ds: &FoodDataset) -> Result<()> {
-        check_disjoint(&self.sets(), ds)
+        let named = self
+            .sets()
+            .map(|(set, foods)| (format!("split.{set}"), foods));
+        let sets: Vec<(&str, &[String])> = named.iter().map(|(n, f)| (n.as_str(), *f)).collect();
+        check_disjoint(&sets, ds)
     }
 }
 
-/// Checks named food lists against `ds`: non-empty, known, disjoint.
+/// Checks named food lists against `ds`: non-empty, known, disjoint. An
+/// error names the list as given (`foods`), for the caller to put under
+/// its table ([`HilError::within`]).
 pub fn check_disjoint(sets: &[(&str, &[String])], ds: &FoodDataset) -> Result<()> {
     let mut seen: Vec<(&str, &str)> = Vec::new();
     for (set, foods) in sets {
         if foods.is_empty() {
-            return Err(HilError::invalid_parameter(
-                format!("split.{set}"),
-                "[]",
-                "the set is empty",
-            ));
+            return Err(HilError::invalid_parameter(*set, "[]", "the set is empty"));
         }
         for f in foods.iter() {
             if ds.food_index(f).is_none() {
                 return Err(HilError::invalid_parameter(
-                    format!("split.{set}"),
+                    *set,
                     f,
                     format!(
                         "unknown food; dataset `{}` has: {}",
@@ -80,9 +82,9 @@ pub fn check_disjoint(sets: &[(&str, &[String])], ds: &FoodDataset) -> Result<()
             }
             if let Some((other, _)) = seen.iter().find(|(_, g)| g == f) {
                 return Err(HilError::invalid_parameter(
-                    format!("split.{set}"),
+                    *set,
                     f,
-                    format!("the food is also in split.{other}; a food may be in one set only"),
+                    format!("the food is also in `{other}`; a food may be in one list only"),
                 ));
             }
             seen.push((set, f));

@@ -116,16 +116,38 @@ impl ExperimentConfig {
     /// The environment is built first, so that the policy and the channel
     /// know its action space and context dimension.
     pub fn build(&self, base_dir: &Path) -> Result<Experiment> {
+        self.build_with(base_dir, |_, e| e)
+    }
+
+    /// [`build`](Self::build), for the config read from `text` at `path`:
+    /// an error raised in building a component (an unknown food, a
+    /// bundled model that does not exist, a dataset file that cannot be
+    /// read) is located in the file, at the component's key.
+    pub fn build_located(&self, base_dir: &Path, text: &str, path: &Path) -> Result<Experiment> {
+        self.build_with(base_dir, |section, e| {
+            error_in_section(text, path, &[section], e).into()
+        })
+    }
+
+    fn build_with(
+        &self,
+        base_dir: &Path,
+        locate: impl Fn(&str, HilError) -> HilError,
+    ) -> Result<Experiment> {
         let ctx = BuildContext::new(base_dir, self.seed);
-        let environment = self.environment.build(&ctx)?;
-        let task = ctx.describe_environment(self.environment.as_ref(), environment.as_ref())?;
-        let policy = self.policy.build(&task)?;
-        let workload = self.workload.build(&ctx)?;
+        let locate = &locate;
+        let at = |section: &'static str| move |e| locate(section, e);
+        let environment = self.environment.build(&ctx).map_err(at("environment"))?;
+        let task = ctx
+            .describe_environment(self.environment.as_ref(), environment.as_ref())
+            .map_err(at("environment"))?;
+        let policy = self.policy.build(&task).map_err(at("policy"))?;
+        let workload = self.workload.build(&ctx).map_err(at("workload"))?;
         let forecast = match &self.policy_workload {
-            Some(c) => Some(c.build(&ctx)?),
+            Some(c) => Some(c.build(&ctx).map_err(at("policy_workload"))?),
             None => None,
         };
-        let channel = self.channel.build(&task)?;
+        let channel = self.channel.build(&task).map_err(at("channel"))?;
         Ok(Experiment {
             settings: self.session.clone(),
             seed: self.seed,

@@ -11,52 +11,38 @@ use hil_core::{HilError, Result, Session, SessionObserver};
 
 use crate::experiment::{Experiment, ExperimentSummary};
 
-/// Where a resumed session starts, derived from its log.
+/// What a resumed session replays, derived from its log.
+///
+/// A resume replays the whole logged session from the header's config and
+/// seed, checking every record it produces against the log (decisions,
+/// outcomes, episode summaries, checkpoints), and only then appends. It
+/// does not restore the last checkpoint and trust what came before: an
+/// episode summary edited to disagree with its steps, or a header whose
+/// config was changed, would then pass unseen (and the chain, having no
+/// key, can be recomputed by whoever edits the log). The logged answers
+/// are given back in order, so no person is asked twice.
 struct ResumePlan {
-    start_episode: usize,
-    /// The checkpoint to restore: its episode, state and log line.
-    restore: Option<(usize, serde_json::Value, usize)>,
-    metrics_before: Vec<EpisodeMetrics>,
     expected: Vec<LoggedRecord>,
     answers: VecDeque<hil_core::record::LoggedAnswer>,
 }
 
 fn plan(session: &LoggedSession, log: &RecordLog) -> Result<ResumePlan> {
-    let data_err = |line: usize, field: &str, why: String| HilError::Data {
-        path: log.path().to_path_buf(),
-        record: line,
-        field: field.to_string(),
-        why,
-    };
-    // The last checkpoint whose episode ends are all present.
-    let mut ends: Vec<EpisodeMetrics> = Vec::new();
-    let mut cut = None;
-    for (i, r) in session.records.iter().enumerate() {
-        match &r.record {
-            Record::EpisodeEnd { episode, metrics } => {
-                if *episode != ends.len() {
-                    return Err(data_err(
-                        r.line,
-                        "episode",
-                        format!(
-                            "episode {episode} ends where episode {} was expected",
-                            ends.len()
-                        ),
-                    ));
-                }
-                ends.push(metrics.clone());
+    let mut ended = 0;
+    for r in &session.records {
+        if let Record::EpisodeEnd { episode, .. } = &r.record {
+            if *episode != ended {
+                return Err(HilError::Data {
+                    path: log.path().to_path_buf(),
+                    record: r.line,
+                    field: "episode".into(),
+                    why: format!("episode {episode} ends where episode {ended} was expected"),
+                });
             }
-            Record::Checkpoint { episode, policy } if *episode + 1 == ends.len() => {
-                cut = Some((i, *episode, policy.clone(), r.line));
-            }
-            _ => {}
+            ended += 1;
         }
     }
-    let (first, start_episode, restore, metrics_before) = match cut {
-        Some((i, k, state, line)) => (i + 1, k + 1, Some((k, state, line)), ends[..=k].to_vec()),
-        None => (0, 0, None, Vec::new()),
-    };
-    let expected: Vec<LoggedRecord> = session.records[first..]
+    let expected: Vec<LoggedRecord> = session
+        .records
         .iter()
         .filter(|r| !matches!(r.record, Record::Resumed { .. }))
         .cloned()
@@ -71,13 +57,7 @@ fn plan(session: &LoggedSession, log: &RecordLog) -> Result<ResumePlan> {
             _ => None,
         })
         .collect();
-    Ok(ResumePlan {
-        start_episode,
-        restore,
-        metrics_before,
-        expected,
-        answers,
-    })
+    Ok(ResumePlan { expected, answers })
 }
 
 /// Runs `exp`, recording every step into `log`; with `resume` (the log's
@@ -98,9 +78,6 @@ pub fn run_recorded(
         None => (
             Recorder::new(log),
             ResumePlan {
-                start_episode: 0,
-                restore: None,
-                metrics_before: Vec::new(),
                 expected: Vec::new(),
                 answers: VecDeque::new(),
             },
@@ -121,24 +98,14 @@ pub fn run_recorded(
             let marker = Record::Resumed {
                 lines: log.lines(),
                 truncated_bytes: session.truncated_bytes,
-                from_checkpoint: plan.restore.as_ref().map(|(k, _, _)| *k),
+                // Every resume replays from the start (see `ResumePlan`).
+                from_checkpoint: None,
             };
             let expected = std::mem::take(&mut plan.expected);
             (Recorder::resuming(log, expected, marker), plan)
         }
     };
-    if let Some((k, state, line)) = plan.restore {
-        exp.policy.restore(state).map_err(|e| HilError::Data {
-            path: path.clone(),
-            record: line,
-            field: format!("checkpoint of episode {k}"),
-            why: format!("the policy could not restore it: {e}"),
-        })?;
-    }
-    let mut metrics = plan.metrics_before;
-    for (k, m) in metrics.iter().enumerate() {
-        on_episode(k, m);
-    }
+    let mut metrics = Vec::with_capacity(exp.episodes);
     let seeds: Vec<u64> = (0..exp.episodes).map(|k| exp.episode_seed(k)).collect();
     let mut channel = ReplayChannel {
         inner: exp.channel.as_mut(),
@@ -146,7 +113,7 @@ pub fn run_recorded(
         episode: 0,
         path: path.clone(),
     };
-    for (k, &seed) in seeds.iter().enumerate().skip(plan.start_episode) {
+    for (k, &seed) in seeds.iter().enumerate() {
         recorder.set_episode(k);
         channel.episode = k;
         let mut session = Session::new(

@@ -117,7 +117,7 @@ impl Run {
         let base = config_abs
             .parent()
             .map_or_else(|| config_abs.clone(), Path::to_path_buf);
-        let experiment = cfg.build(&base)?;
+        let experiment = cfg.build_located(&base, &text, config)?;
         let recording = match log {
             Some(path) => {
                 let header = Header::new(
@@ -155,7 +155,8 @@ impl Run {
         };
         let header = &logged.header;
         let cfg = crate::parse_experiment(&header.config, &header.config_path)?;
-        let experiment = cfg.build(&header.base_dir)?;
+        let experiment =
+            cfg.build_located(&header.base_dir, &header.config, &header.config_path)?;
         Ok(Self {
             experiment,
             recording,

@@ -84,8 +84,21 @@ impl<'a> CsvFile<'a> {
     /// Reads the header of `text` (read from `path`); a text without one
     /// is an error at line 1, field `header`. A UTF-8 byte-order mark
     /// (which some spreadsheet programs write) is ignored.
+    ///
+    /// A quoted field still open at the end of the text (a last line
+    /// ending in a lone `"`) is an error at the line the quote opened:
+    /// the `csv` crate would close it silently, where RFC 4180 (and
+    /// Python's `csv` in strict mode: "unexpected end of data") refuse it.
     pub fn parse(text: &'a str, path: &Path) -> Result<Self> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        if let Some(line) = unclosed_quote(text) {
+            return Err(data_error(
+                path,
+                line,
+                "record",
+                "not valid CSV: a quoted field opened on this line is never closed",
+            ));
+        }
         let reader = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)
@@ -174,6 +187,42 @@ impl<'a> CsvFile<'a> {
     pub fn error(&self, line: usize, field: &str, why: impl Into<String>) -> HilError {
         data_error(&self.path, line, field, why)
     }
+}
+
+/// The 1-based line of a quoted field that `text` leaves open, if any.
+/// Quotes are read as the `csv` crate reads them: a field is quoted when
+/// its first byte is `"`, `""` inside it is a quote, and a `"` inside an
+/// unquoted field is a plain character. One pass, no allocation.
+fn unclosed_quote(text: &str) -> Option<usize> {
+    #[derive(PartialEq)]
+    enum State {
+        FieldStart,
+        Unquoted,
+        Quoted,
+        QuoteInQuoted,
+    }
+    let mut state = State::FieldStart;
+    let (mut line, mut opened_at) = (1, 1);
+    for &b in text.as_bytes() {
+        let separator = matches!(b, b',' | b'\n' | b'\r');
+        state = match state {
+            State::FieldStart | State::Unquoted | State::QuoteInQuoted if separator => {
+                State::FieldStart
+            }
+            State::FieldStart if b == b'"' => {
+                opened_at = line;
+                State::Quoted
+            }
+            State::Quoted if b == b'"' => State::QuoteInQuoted,
+            State::Quoted => State::Quoted,
+            State::QuoteInQuoted if b == b'"' => State::Quoted,
+            _ => State::Unquoted,
+        };
+        if b == b'\n' {
+            line += 1;
+        }
+    }
+    (state == State::Quoted).then_some(opened_at)
 }
 
 fn bytecount_newlines(bytes: &[u8]) -> usize {
@@ -296,6 +345,28 @@ mod tests {
         let got = lines(&text);
         assert_eq!(got[1].0, 2);
         assert_eq!(got[1].1, fields);
+    }
+
+    #[test]
+    fn a_quoted_field_left_open_is_refused_at_its_line() {
+        for (text, line) in [
+            ("a,b\n1,\"", 2),
+            ("a,b\n1,\"x\n\n2,3\n", 2),
+            ("a,b\n1,\"x\"\"\n", 2),
+            ("\"a,b\n", 1),
+        ] {
+            match CsvFile::parse(text, Path::new("t.csv")).unwrap_err() {
+                HilError::Data { record, field, .. } => {
+                    assert_eq!((record, field.as_str()), (line, "record"), "{text:?}")
+                }
+                other => panic!("{other:?}"),
+            }
+        }
+        // Closed quotes, escaped quotes and a quote inside an unquoted
+        // field are fine.
+        for text in ["a,b\n1,\"\"\n", "a,b\n1,\"x\"\"y\"\n", "a,b\n1,x\"y\n"] {
+            assert!(CsvFile::parse(text, Path::new("t.csv")).is_ok(), "{text:?}");
+        }
     }
 
     #[test]

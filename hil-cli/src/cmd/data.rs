@@ -1,5 +1,6 @@
 //! `hil data generate` and `hil data check`: the food dataset.
 
+use crate::out::outln;
 use std::path::PathBuf;
 
 use hil_envs::dataset::FoodDataset;
@@ -81,7 +82,7 @@ fn generate(a: GenerateArgs) -> hil_core::Result<()> {
     }
     let written = g.write_into(&a.out, a.force)?;
     let (out, manifest, p) = (&written.generated, &written.manifest, &written.parameters);
-    println!(
+    outln!(
         "wrote {} ({} foods, {} images, d = {}); generator parameters in {}",
         manifest.display(),
         out.dataset.foods.len(),
@@ -92,27 +93,28 @@ fn generate(a: GenerateArgs) -> hil_core::Result<()> {
             .sum::<usize>(),
         g.dim,
         p.display()
-    );
-    println!("data provenance: {}", out.dataset.provenance);
+    )?;
+    outln!("data provenance: {}", out.dataset.provenance)?;
     Ok(())
 }
 
 fn check(a: CheckArgs) -> hil_core::Result<()> {
     let ds = FoodDataset::load(&a.path)?;
     let rates = PublishedRates::bundled()?;
-    println!(
+    outln!(
         "{}: {} foods, d = {}, actions {}, settings {}",
         ds.name,
         ds.foods.len(),
         ds.context_dim,
         ds.actions.names().join(" "),
         ds.settings.join(" ")
-    );
-    println!("provenance: {}", ds.provenance);
-    println!(
+    )?;
+    outln!("provenance: {}", ds.provenance)?;
+    outln!(
         "{:<14} {:>6}  mean s(x,a) per action (published pooled rate in brackets, where known)",
-        "food", "images"
-    );
+        "food",
+        "images"
+    )?;
     for f in &ds.foods {
         let pub_rates = rates.food(&f.name);
         let cells: Vec<String> = f
@@ -126,7 +128,7 @@ fn check(a: CheckArgs) -> hil_core::Result<()> {
                 _ => format!("{m:.2}"),
             })
             .collect();
-        println!("{:<14} {:>6}  {}", f.name, f.images.len(), cells.join("  "));
+        outln!("{:<14} {:>6}  {}", f.name, f.images.len(), cells.join("  "))?;
     }
     Ok(())
 }

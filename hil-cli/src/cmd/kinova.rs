@@ -13,6 +13,7 @@
 //!   n_success and n_q per plate and their mean ± standard error per method.
 //!   This file only reads arguments, renders keyframes and prints.
 
+use crate::out::{note, out, outln};
 use std::path::{Path, PathBuf};
 
 use hil_core::{HilError, Result};
@@ -216,9 +217,9 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
             } else {
                 String::new()
             };
-            eprint!("\rsimulated {done}/{total} attempts{of_runs}");
+            crate::out::stderr(format_args!("\rsimulated {done}/{total} attempts{of_runs}"));
             if done == total {
-                eprintln!();
+                note!();
             }
         }
     };
@@ -260,10 +261,10 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
 }
 
 fn print_json(value: &impl serde::Serialize) -> Result<()> {
-    println!(
+    outln!(
         "{}",
         serde_json::to_string_pretty(value).map_err(|e| HilError::serde("report", e))?
-    );
+    )?;
     Ok(())
 }
 
@@ -318,20 +319,22 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
     let cfg = demo_config(&args)?;
     let quiet = args.quiet;
     if !quiet {
-        eprintln!("building the environment and its pretraining data (once, for every method)");
+        note!("building the environment and its pretraining data (once, for every method)");
     }
     let run = cfg.run_pictured(
         &components_dir(&args),
         args.render.as_deref(),
         &mut |plate: &Plate| {
             if !quiet {
-                eprintln!(
+                note!(
                     "repetition {} plate {}: {}",
-                    plate.repetition, plate.position, plate.label
+                    plate.repetition,
+                    plate.position,
+                    plate.label
                 );
             }
         },
-        &mut |note| eprintln!("note: {note}"),
+        &mut |note| note!("note: {note}"),
     )?;
     if args.json {
         print_json_with_note(&run.result)?;
@@ -343,7 +346,7 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
         )?;
     }
     if let Some(k) = run.keyframes {
-        eprintln!("wrote {} keyframes to {}", k.written, k.dir.display());
+        note!("wrote {} keyframes to {}", k.written, k.dir.display());
     }
     Ok(())
 }
@@ -355,7 +358,7 @@ const USER_STUDY_TITLE: &str = "The user-study protocol in the Kinova simulation
 /// Prints a report and, with `--write-doc FILE`, keeps it as a results
 /// page naming this command line.
 fn emit(report: &str, write_doc: Option<&Path>, title: &str) -> Result<()> {
-    print!("{report}");
+    out!("{report}")?;
     if let Some(path) = write_doc {
         let command = super::command_line();
         ResultsPage {
@@ -364,7 +367,7 @@ fn emit(report: &str, write_doc: Option<&Path>, title: &str) -> Result<()> {
             report,
         }
         .write(path)?;
-        eprintln!("wrote {}", path.display());
+        note!("wrote {}", path.display());
     }
     Ok(())
 }
@@ -375,10 +378,10 @@ fn print_json_with_note(value: &impl serde::Serialize) -> Result<()> {
     if let Some(fields) = out.as_object_mut() {
         fields.insert("note".into(), NOTE.into());
     }
-    println!(
+    outln!(
         "{}",
         serde_json::to_string_pretty(&out).map_err(|e| HilError::serde("demo report", e))?
-    );
+    )?;
     Ok(())
 }
 
@@ -404,7 +407,7 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
         &args.threads.runner()?,
         &|seed| {
             if !quiet {
-                eprintln!("seed {seed} done");
+                note!("seed {seed} done");
             }
         },
     )?;

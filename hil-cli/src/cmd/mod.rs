@@ -36,6 +36,7 @@ impl Threads {
 /// This run's command line as a person would type it (`hil` and the
 /// arguments, shell-quoted where needed), for results pages to name the
 /// command that wrote them.
+#[cfg_attr(not(feature = "physics"), allow(dead_code))]
 pub fn command_line() -> String {
     let quote = |a: String| {
         let plain = !a.is_empty()

@@ -5,6 +5,7 @@
 //! types) listed in the protocol settings; the workload models are
 //! hil-workload's bundled simulation models.
 
+use crate::out::{note, outln};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -107,28 +108,28 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
     let (reproduction, written) = report(&protocol, &records, Some(&args.out), &mut timing)?;
 
     if !args.quiet {
-        eprintln!(
+        note!(
             "{} episodes on {threads} thread(s): setup {:.2} s, runs {:.2} s, report {:.2} s",
             records.len(),
             setup_s,
             runs_s,
             timing.report_s
         );
-        eprintln!("data: {}", dataset.provenance);
+        note!("data: {}", dataset.provenance);
         let plot_w = settings.figure_w_task();
         let results = reproduction.headline();
-        println!(
+        outln!(
             "w_task = {plot_w}, test set, {} environment seeds, mean ± {} (synthetic data, not the paper's results):",
             results.n_env_seeds,
             match results.spread {
                 hil_experiments::results::Spread::Std => "population std",
                 hil_experiments::results::Spread::Se => "standard error",
             }
-        );
+        )?;
         for m in &results.models {
             for method in &settings.methods {
                 if let Some(r) = results.row(m, plot_w, &method.label) {
-                    println!(
+                    outln!(
                         "  {m:<13} {:<16} r_task_avg {:.3} ± {:.3}  ΔWL {:+.3} ± {:.3}  M_wt {:.3} ± {:.3}  f_q {:.3} ± {:.3}{}",
                         method.label,
                         r.test.r_task_avg.mean,
@@ -142,12 +143,12 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
                         r.selected
                             .as_ref()
                             .map_or(String::new(), |h| format!("  ({} = {})", h.name, h.value))
-                    );
+                    )?;
                 }
             }
         }
         for f in written.iter().flat_map(Written::paths) {
-            println!("wrote {}", f.display());
+            outln!("wrote {}", f.display())?;
         }
     }
     Ok(())

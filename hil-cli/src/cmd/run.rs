@@ -1,6 +1,7 @@
 //! `hil run --config FILE [--log LOG]`: run an experiment config, recording
 //! every step; `hil run --resume LOG`: continue a recorded session.
 
+use crate::out::{note, outln};
 use std::path::{Path, PathBuf};
 
 use hil_core::{EpisodeMetrics, HilError, SessionObserver};
@@ -59,7 +60,7 @@ pub fn run(args: RunArgs) -> hil_core::Result<()> {
         return Ok(());
     };
     for e in errors {
-        eprintln!("error: {e}");
+        note!("error: {e}");
     }
     Err(first)
 }
@@ -92,9 +93,15 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
     }
     let progress = |k: usize, m: &EpisodeMetrics| {
         if !quiet {
-            eprintln!(
+            note!(
                 "episode {k}: items {} steps {} r_task_avg {:.3} ΔWL {:+.3} f_q {:.3} n_q {} n_success {}",
-                m.n_items, m.n_steps, m.r_task_avg, m.delta_wl, m.f_q, m.n_q, m.n_success
+                m.n_items,
+                m.n_steps,
+                m.r_task_avg,
+                m.delta_wl,
+                m.f_q,
+                m.n_q,
+                m.n_success
             );
         }
     };
@@ -108,7 +115,7 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
         Start::Resume(log) => Run::resume(log)?,
     };
     if !quiet && let Some(logged) = run.recording.logged() {
-        eprintln!(
+        note!(
             "resuming {} ({} records{})",
             run.recording.path().unwrap_or(Path::new("")).display(),
             logged.records.len() + 1,
@@ -124,7 +131,7 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
     }
     announce_endpoint(run.experiment.channel.endpoint());
     if !quiet && let Recording::New(log) = &run.recording {
-        eprintln!("recording to {}", log.path().display());
+        note!("recording to {}", log.path().display());
     }
     let summary = run.execute(&mut observers, progress)?;
     drop(observers);
@@ -149,11 +156,11 @@ fn install_interrupt_notice(log: Option<PathBuf>) {
         .spawn(move || {
             if signals.forever().next().is_some() {
                 match &log {
-                    Some(p) => eprintln!(
+                    Some(p) => note!(
                         "\ninterrupted: every answered step is in {0}; continue with `hil run --resume {0}`",
                         p.display()
                     ),
-                    None => eprintln!(
+                    None => note!(
                         "\ninterrupted: no interaction log was kept (run with --log LOG to be able to resume)"
                     ),
                 }
@@ -169,22 +176,22 @@ fn install_interrupt_notice(_log: Option<PathBuf>) {}
 /// Printed even with --quiet: without it nobody can answer.
 fn announce_endpoint(endpoint: Option<String>) {
     if let Some(urls) = endpoint {
-        eprintln!("open this address on the phone or tablet to answer the robot's questions:");
+        note!("open this address on the phone or tablet to answer the robot's questions:");
         // One line per address (a web page bound to 0.0.0.0 has several).
         for url in urls.lines() {
-            eprintln!("  {url}");
+            note!("  {url}");
         }
     }
 }
 
 fn print_summary(summary: &ExperimentSummary, json: bool, quiet: bool) -> hil_core::Result<()> {
     if json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(summary).map_err(|e| HilError::serde("summary", e))?
-        );
+        )?;
     } else if !quiet {
-        println!(
+        outln!(
             "{} episode(s): r_task_avg {:.3} ± {:.3}, ΔWL {:+.3} ± {:.3}, f_q {:.3} ± {:.3}, t_conv {:.2} ± {:.2}",
             summary.episodes.len(),
             summary.r_task_avg.0,
@@ -195,7 +202,7 @@ fn print_summary(summary: &ExperimentSummary, json: bool, quiet: bool) -> hil_co
             summary.f_q.1,
             summary.t_conv.0,
             summary.t_conv.1,
-        );
+        )?;
     }
     Ok(())
 }

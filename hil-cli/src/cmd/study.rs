@@ -1,6 +1,7 @@
 //! `hil study …`: run the querying-workload study in the browser, follow
 //! the participants' progress, export the study CSV for `hil workload`.
 
+use crate::out::outln;
 use std::net::{IpAddr, Ipv4Addr};
 use std::path::PathBuf;
 
@@ -142,12 +143,12 @@ pub fn run(args: StudyArgs) -> Result<()> {
             };
             apply_flags(&mut cfg.server, lan, port, tls_cert, tls_key);
             let server = StudyServer::start(cfg, &data)?;
-            println!("Study data: {}", data.display());
+            outln!("Study data: {}", data.display())?;
             if let Some(p) = server.moved_from() {
-                println!(
+                outln!(
                     "Port {p} of the last run is taken: the links below are new (the tokens are not); \
                      give --port to choose one."
-                );
+                )?;
             }
             if let Some(tls) = server.tls() {
                 let whose = match tls.source() {
@@ -157,14 +158,14 @@ pub fn run(args: StudyArgs) -> Result<()> {
                     }
                     CertSource::SelfSignedKept => "the data folder's self-signed certificate",
                 };
-                println!(
+                outln!(
                     "HTTPS with {whose}; its SHA-256 fingerprint (check it in the browser before accepting):"
-                );
-                println!("  {}", tls.fingerprint());
+                )?;
+                outln!("  {}", tls.fingerprint())?;
             }
-            println!("Researcher's page (keep this link to yourself):");
+            outln!("Researcher's page (keep this link to yourself):")?;
             for u in server.researcher_urls() {
-                println!("  {u}");
+                outln!("  {u}")?;
             }
             for (id, pop) in enrol {
                 let (done, urls) = server.enrol_as(&id, pop)?;
@@ -172,12 +173,12 @@ pub fn run(args: StudyArgs) -> Result<()> {
                     Enrolment::New => "enrolled now",
                     Enrolment::Already => "enrolled before, not enrolled again",
                 };
-                println!("Participant {id} ({}, {note}):", pop.as_str());
+                outln!("Participant {id} ({}, {note}):", pop.as_str())?;
                 for u in urls {
-                    println!("  {u}");
+                    outln!("  {u}")?;
                 }
             }
-            println!("Serving; stop with Ctrl-C (answers are saved as they come).");
+            outln!("Serving; stop with Ctrl-C (answers are saved as they come).")?;
             match for_s {
                 Some(s) if s.is_finite() && s >= 0.0 => {
                     std::thread::sleep(std::time::Duration::from_secs_f64(s));
@@ -210,7 +211,7 @@ pub fn run(args: StudyArgs) -> Result<()> {
                 else {
                     continue;
                 };
-                println!(
+                outln!(
                     "{participant} {}: {}/{} conditions, {} surveys ({} in the study CSV, \
                      {} at the end of a query condition)",
                     population.as_str(),
@@ -219,14 +220,14 @@ pub fn run(args: StudyArgs) -> Result<()> {
                     t.surveys,
                     t.surveys - t.end_of_condition_surveys,
                     t.end_of_condition_surveys
-                );
+                )?;
             }
             Ok(())
         }
         StudyCommand::Export { data, out } => {
             let export = export_all(&data)?;
             let end = export.write(&out)?;
-            println!(
+            outln!(
                 "wrote {} surveys: {} to {} (read it with `hil workload summary --data {}`), \
                  {} end-of-condition surveys to {}",
                 export.surveys(),
@@ -235,7 +236,7 @@ pub fn run(args: StudyArgs) -> Result<()> {
                 out.display(),
                 export.end_of_condition.len(),
                 end.display()
-            );
+            )?;
             Ok(())
         }
     }

@@ -1,6 +1,7 @@
 //! `hil workload …`: generate study data, select and fit workload models,
 //! roll a model out over a query schedule, regenerate the bundled models.
 
+use crate::out::{note, out, outln};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -172,13 +173,13 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let study = cfg.generate(seed)?;
             study.write_csv(&out)?;
             if !quiet {
-                println!(
+                outln!(
                     "wrote {} ({} surveys)",
                     out.display(),
                     study.records().len()
-                );
-                print!("{}", StudySummary::of(&study)?.to_text());
-                println!("{SYNTHETIC}");
+                )?;
+                out!("{}", StudySummary::of(&study)?.to_text())?;
+                outln!("{SYNTHETIC}")?;
             }
             Ok(())
         }
@@ -187,8 +188,8 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             // Summarised before anything is printed: a study that cannot be
             // summarised prints only its error.
             let summary = StudySummary::of(&study)?;
-            println!("{}: {} surveys", data.display(), study.records().len());
-            print!("{}", summary.to_text());
+            outln!("{}: {} surveys", data.display(), study.records().len())?;
+            out!("{}", summary.to_text())?;
             Ok(())
         }
         WorkloadCommand::Select {
@@ -204,10 +205,10 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let elapsed = t0.elapsed();
             table.write_to(&out)?;
             if !quiet {
-                print!("{}", table.to_markdown());
+                out!("{}", table.to_markdown())?;
                 for id in DatasetId::ALL {
                     if let Some(b) = table.best(id) {
-                        println!(
+                        outln!(
                             "selected on {}: {}{} (median test MSE {:.4})",
                             id.as_str().to_uppercase(),
                             b.candidate.label(),
@@ -215,17 +216,17 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                                 .history()
                                 .map_or(String::new(), |h| format!(" H = {h}")),
                             b.median
-                        );
+                        )?;
                     }
                 }
-                println!("wrote {}/selection.{{md,csv,json}}", out.display());
+                outln!("wrote {}/selection.{{md,csv,json}}", out.display())?;
             }
-            println!(
+            outln!(
                 "selection table: {} rows in {:.3} s (datasets + nested CV, {} threads requested)",
                 table.rows.len(),
                 elapsed.as_secs_f64(),
                 opts.threads
-            );
+            )?;
             Ok(())
         }
         WorkloadCommand::Fit {
@@ -242,13 +243,13 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let cand = Candidate::parse(&model, history)?;
             let m = fit_study_model(&study, id, cand, &cv.options(), name)?;
             m.save(&out)?;
-            println!(
+            outln!(
                 "wrote {} ({} on {}, {} pairs)",
                 out.display(),
                 cand.label(),
                 id.as_str().to_uppercase(),
                 m.provenance.n_pairs.unwrap_or_default()
-            );
+            )?;
             Ok(())
         }
         WorkloadCommand::Rollout {
@@ -266,10 +267,10 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let last = queries.last().map_or(0, |q| q.0);
             let end = steps.unwrap_or(last + 10);
             let points = rollout(&m, wl0, &queries, end)?;
-            println!("t,seconds,wl,query");
+            outln!("t,seconds,wl,query")?;
             for p in &points {
                 let asked: Vec<String> = p.asked.iter().map(ToString::to_string).collect();
-                println!("{},{},{:.4},{}", p.t, p.t * 10, p.wl, asked.join(" "));
+                outln!("{},{},{:.4},{}", p.t, p.t * 10, p.wl, asked.join(" "))?;
             }
             if let Some(path) = svg {
                 let wl: Vec<f64> = points.iter().map(|p| p.wl).collect();
@@ -286,7 +287,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 };
                 let svg = hil_experiments::plot::workload_curve_svg(&title, &note, &wl, &asked);
                 hil_core::files::write_text(&path, &svg)?;
-                eprintln!("wrote {}", path.display());
+                note!("wrote {}", path.display());
             }
             Ok(())
         }
@@ -299,31 +300,34 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let t0 = Instant::now();
             if centre {
                 let (c, spread) = hil_workload::seeds::centre(&cfg, 0..count, 0.002, 8)?;
-                print!("{}", spread.to_text());
+                out!("{}", spread.to_text())?;
                 let p = &c.params;
-                println!(
+                outln!(
                     "calibrated: mean = {}, population_shift = {}, participant_sd = {}, limited_survey_sd = {}",
-                    p.mean, p.population_shift, p.participant_sd, p.limited_survey_sd
-                );
+                    p.mean,
+                    p.population_shift,
+                    p.participant_sd,
+                    p.limited_survey_sd
+                )?;
             } else {
-                print!(
+                out!(
                     "{}",
                     hil_workload::seeds::SeedSpread::over(&cfg, 0..count)?.to_text()
-                );
+                )?;
             }
             use std::io::Write as _;
             let _ = std::io::stdout().flush();
-            eprintln!("{:.1} s. {SYNTHETIC}", t0.elapsed().as_secs_f64());
+            note!("{:.1} s. {SYNTHETIC}", t0.elapsed().as_secs_f64());
             Ok(())
         }
         WorkloadCommand::Calibrate { dir, check } => {
             let models = hil_experiments::calibrate::all()?;
-            print!("{}", hil_experiments::calibrate::report(&models)?);
+            out!("{}", hil_experiments::calibrate::report(&models)?)?;
             if !check {
                 for m in &models {
                     let path = hil_experiments::calibrate::model_path(&dir, m);
                     m.save(&path)?;
-                    eprintln!("wrote {}", path.display());
+                    note!("wrote {}", path.display());
                 }
                 return Ok(());
             }
@@ -346,17 +350,17 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             let t0 = Instant::now();
             let WrittenBundle { summary, models } = write_bundle(&dir, &cv.options())?;
             for m in &models {
-                println!(
+                outln!(
                     "wrote models/{}.json: {}",
                     m.name,
                     m.provenance.note.as_deref().unwrap_or("")
-                );
+                )?;
             }
-            print!("{}", summary.to_text());
-            println!(
+            out!("{}", summary.to_text())?;
+            outln!(
                 "bundle regenerated in {:.2} s. {SYNTHETIC}",
                 t0.elapsed().as_secs_f64()
-            );
+            )?;
             Ok(())
         }
     }

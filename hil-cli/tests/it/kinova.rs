@@ -121,8 +121,7 @@ fn calibrate_prints_rates_beside_the_published_ones() {
 #[test]
 #[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn the_demo_runs_a_study_file_and_renders_or_says_why_not() {
-    let dir = std::env::temp_dir().join(format!("hil-kinova-demo-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::demo::scratch_dir("kinova-demo", "study");
     let study = dir.join("study.toml");
     // Repetitions and N_att come from the flags, which override the file;
     // the workload model is the default one, left out.

@@ -5,22 +5,15 @@
 use crate::common;
 use common::hil;
 
+use crate::demo::scratch_dir;
+use crate::study::food_replay_study;
+
 #[test]
 #[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn many_seeds_report_means_with_standard_errors_and_the_chosen_w() {
-    let dir = std::env::temp_dir().join(format!("hil-kinova-seeds-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch_dir("kinova-seeds", "study");
     let study = dir.join("study.toml");
-    std::fs::write(
-        &study,
-        r#"
-repetitions = 2
-[environment]
-type = "food_replay"
-foods = ["banana", "carrot", "cantaloupe"]
-pretrain_foods = ["apple", "kiwi", "strawberry"]
-items_per_episode = 3
-[validation]
+    let methods = r#"[validation]
 plates = 2
 [[methods]]
 label = "LinUCB"
@@ -32,9 +25,9 @@ policy = { type = "always_query", alpha = 0.5, pretrain = true }
 label = "LinUCB-QG"
 policy = { type = "linucb_qg", alpha = 0.5, w = 1.0, pretrain = true }
 tune = { w = [0.5, 8.0] }
-"#,
-    )
-    .unwrap();
+"#;
+    let text = food_replay_study(2, r#""banana", "carrot", "cantaloupe""#, methods);
+    std::fs::write(&study, text).unwrap();
     let out = hil(&[
         "demo",
         "kinova",

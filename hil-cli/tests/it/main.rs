@@ -2,9 +2,14 @@
 //! link instead of one per file); each module was a file of its own.
 
 mod common;
+#[path = "../../../tests/support/demo.rs"]
+mod demo;
+#[path = "../../../tests/support/study.rs"]
+mod study;
 
 mod bench;
 mod cli;
+mod closed_pipes;
 mod data_inputs;
 #[cfg(feature = "physics")]
 mod kinova;

@@ -42,6 +42,7 @@ fn data_generate_check_then_reproduce_quick() {
     assert!(text(&check).contains("banana") && text(&check).contains("synthetic"));
 
     let res = root.join("out");
+    let res_s = res.to_str().unwrap();
     let out = hil(&[
         "reproduce",
         "--quick",
@@ -49,7 +50,7 @@ fn data_generate_check_then_reproduce_quick() {
         "--dataset",
         ds_s,
         "--out",
-        res.to_str().unwrap(),
+        res_s,
     ]);
     assert!(out.status.success(), "{}", text(&out));
     let json: serde_json::Value =

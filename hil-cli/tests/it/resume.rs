@@ -6,54 +6,32 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const CONFIG: &str = r#"
-seed = 11
-episodes = 3
+use crate::demo::{DemoSession, lines_without_markers, scratch_dir};
 
-[session]
-n_att = 4
-
-[environment]
-type = "demo_plate"
-foods = ["banana", "carrot", "grape", "cantaloupe", "apple"]
-repeat = 4
-
-[policy]
-type = "demo_learner"
-query_probability = 0.5
+fn config_text() -> String {
+    DemoSession {
+        seed: 11,
+        episodes: 3,
+        n_att: Some(4),
+        foods: r#""banana", "carrot", "grape", "cantaloupe", "apple""#,
+        repeat: 4,
+        policy: r#"query_probability = 0.5
 epsilon = 0.2
-kinds = [{ response = "mcq" }, { response = "bounding_box", difficulty = "hard" }, { response = "open_ended" }]
-
-[workload]
-type = "demo_counting"
-increment = 0.05
-window = 10
-
-[channel]
-type = "simulated_expert"
+kinds = [{ response = "mcq" }, { response = "bounding_box", difficulty = "hard" }, { response = "open_ended" }]"#,
+        channel: r#"type = "simulated_expert"
 error_rate = 0.2
 decline_rate = 0.15
-response_time = { median_s = 4.0, sigma = 0.5 }
-"#;
+response_time = { median_s = 4.0, sigma = 0.5 }"#,
+    }
+    .toml()
+}
 
 fn hil() -> Command {
     Command::new(env!("CARGO_BIN_EXE_hil"))
 }
 
 fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hil-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn lines_without_markers(path: &Path) -> Vec<String> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .filter(|l| !l.contains(r#""record":"resumed""#))
-        .map(String::from)
-        .collect()
+    scratch_dir("cli", name)
 }
 
 fn line_count(path: &Path) -> usize {
@@ -66,7 +44,7 @@ fn line_count(path: &Path) -> usize {
 fn killed_sessions_resume_to_the_uninterrupted_result() {
     let dir = tmp_dir("resume");
     let config = dir.join("exp.toml");
-    std::fs::write(&config, CONFIG).unwrap();
+    std::fs::write(&config, config_text()).unwrap();
 
     let reference = dir.join("reference.jsonl");
     let out = hil()
@@ -162,7 +140,7 @@ fn resume_and_log_errors_are_clear() {
     assert!(err.contains("missing.jsonl"), "{err}");
 
     let config = dir.join("exp.toml");
-    std::fs::write(&config, CONFIG).unwrap();
+    std::fs::write(&config, config_text()).unwrap();
     let log = dir.join("log.jsonl");
     std::fs::write(&log, "").unwrap();
     let out = hil()

@@ -10,33 +10,19 @@ use std::time::{Duration, Instant};
 
 use hil_conformance::cdylib::{build_cdylibs, cdylib_path};
 
+use crate::demo::{DemoSession, scratch_dir};
+
 /// A short session that queries at every decision, through the channel
 /// whose `[channel]` table body is `channel`.
 fn config(channel: &str) -> String {
-    format!(
-        r#"
-seed = 5
-episodes = 2
-
-[environment]
-type = "demo_plate"
-foods = ["banana", "carrot"]
-repeat = 2
-
-[policy]
-type = "demo_learner"
-query_probability = 1.0
-epsilon = 0.2
-
-[workload]
-type = "demo_counting"
-increment = 0.05
-window = 10
-
-[channel]
-{channel}
-"#
-    )
+    DemoSession {
+        n_att: None,
+        foods: r#""banana", "carrot""#,
+        policy: "query_probability = 1.0\nepsilon = 0.2",
+        channel,
+        ..DemoSession::default()
+    }
+    .toml()
 }
 
 const EXPERT: &str = r#"type = "simulated_expert"
@@ -48,10 +34,7 @@ fn hil() -> Command {
 }
 
 fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hil-cli-run-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    scratch_dir("cli-run", name)
 }
 
 fn stderr_of(out: &std::process::Output) -> String {

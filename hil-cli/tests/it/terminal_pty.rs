@@ -6,31 +6,19 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const CONFIG: &str = r#"
-seed = 3
-episodes = 1
-
-[session]
-n_att = 2
-
-[environment]
-type = "demo_plate"
-foods = ["banana", "carrot", "grape"]
-repeat = 2
-
-[policy]
-type = "demo_learner"
-query_probability = 1.0
-kinds = [{ response = "mcq" }, { response = "bounding_box", difficulty = "hard" }, { response = "open_ended", distraction = "easy" }]
-
-[workload]
-type = "demo_counting"
-increment = 0.05
-window = 10
-
-[channel]
-type = "terminal"
-"#;
+/// A session that asks at every decision, at the terminal.
+fn config_text() -> String {
+    crate::demo::DemoSession {
+        seed: 3,
+        episodes: 1,
+        n_att: Some(2),
+        policy: r#"query_probability = 1.0
+kinds = [{ response = "mcq" }, { response = "bounding_box", difficulty = "hard" }, { response = "open_ended", distraction = "easy" }]"#,
+        channel: r#"type = "terminal""#,
+        ..crate::demo::DemoSession::default()
+    }
+    .toml()
+}
 
 #[derive(Debug)]
 struct Outcome {
@@ -85,7 +73,7 @@ fn logged_responses(log: &Path) -> Vec<serde_json::Value> {
 fn answered_interrupted_and_resumed_through_a_pty() {
     let dir = tmp_dir("interrupt");
     let config = dir.join("terminal.toml");
-    std::fs::write(&config, CONFIG).unwrap();
+    std::fs::write(&config, config_text()).unwrap();
     let log = dir.join("log.jsonl");
 
     // Answer two queries, then Ctrl-C at the third prompt.
@@ -177,7 +165,7 @@ fn answered_interrupted_and_resumed_through_a_pty() {
 fn end_of_input_stops_with_a_clear_error() {
     let dir = tmp_dir("eof");
     let config = dir.join("terminal.toml");
-    std::fs::write(&config, CONFIG).unwrap();
+    std::fs::write(&config, config_text()).unwrap();
     let log = dir.join("log.jsonl");
     let out = drive(
         "eof-after-1",

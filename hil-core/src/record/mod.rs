@@ -16,7 +16,7 @@
 //! | `outcome` | after execution, fsync'ed | `episode`, `t`, `outcome` (`success`, `success_probability`) |
 //! | `episode_end` | episode ends | `episode`, `metrics` |
 //! | `checkpoint` | after `episode_end`, if the policy can save its state | `episode`, `policy` (its [`crate::Policy::save`]) |
-//! | `resumed` | where a resumed session started appending | `lines`, `truncated_bytes`, `from_checkpoint` |
+//! | `resumed` | where a resumed session started appending | `lines`, `truncated_bytes`, `from_checkpoint` (always null now: every resume replays from the start) |
 //!
 //! # One writer, and tamper evidence
 //!
@@ -43,9 +43,11 @@
 //!
 //! 1. an incomplete last line (a write cut short) is discarded; since a step
 //!    is on disk before the robot acts, the robot never acted on it;
-//! 2. the policy is restored from the last checkpoint, and the episodes
-//!    before it are not re-run;
-//! 3. the rest is re-run deterministically from the logged seed: queries
+//! 2. the whole session is re-run from the header's config and seed (a
+//!    checkpoint is checked like any record, not trusted: so an episode
+//!    summary that disagrees with its steps, or a header whose config was
+//!    changed, is refused even when the chain was recomputed);
+//! 3. it is re-run deterministically from the logged seed: queries
 //!    already answered get the person's logged answers (nobody is asked
 //!    twice), and every record the replay produces must equal the logged
 //!    one byte for byte, or resuming stops with an error naming the line;

@@ -215,3 +215,57 @@ fn missing_file_is_an_io_error() {
         "{e:?}"
     );
 }
+
+/// Errors found only in building a component (an unknown food or
+/// pretraining food, a bundled model that does not exist, a dataset file
+/// that cannot be read) name the config file, line and key.
+#[test]
+fn build_errors_are_located_in_the_config() {
+    let dir = std::env::temp_dir().join(format!("hil-build-located-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let base = r#"seed = 1
+episodes = 1
+
+[environment]
+type = "food_replay"
+foods = ["banana", "carrot"]
+pretrain_foods = ["apple", "kiwi"]
+
+[policy]
+type = "linucb"
+alpha = 0.5
+
+[workload]
+type = "bundled"
+name = "f2_sim"
+
+[channel]
+type = "simulated_expert"
+"#;
+    let cases = [
+        ("\"carrot\"]", "\"mango\"]", 6, "environment.foods"),
+        ("\"kiwi\"]", "\"durian\"]", 7, "environment.pretrain_foods"),
+        ("\"f2_sim\"", "\"f9_nope\"", 15, "workload.name"),
+        (
+            "type = \"food_replay\"",
+            "type = \"food_replay\"\ndataset = \"/dev/zero\"",
+            6,
+            "environment.dataset",
+        ),
+    ];
+    for (from, to, line, field) in cases {
+        let path = dir.join("exp.toml");
+        std::fs::write(&path, base.replacen(from, to, 1)).unwrap();
+        match hil_experiments::run::Run::from_config(&path, None) {
+            Err(HilError::Config(e)) => {
+                assert_eq!(
+                    (e.path.as_path(), e.line, e.field.as_deref()),
+                    (path.as_path(), line, Some(field)),
+                    "{e}"
+                );
+            }
+            Err(other) => panic!("{field}: unlocated: {other}"),
+            Ok(_) => panic!("{field}: accepted"),
+        }
+    }
+}

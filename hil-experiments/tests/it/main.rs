@@ -1,6 +1,11 @@
 //! The integration tests of `hil-experiments`, linked into one test binary (one
 //! link instead of one per file); each module was a file of its own.
 
+#[path = "../../../tests/support/demo.rs"]
+mod demo;
+#[path = "../../../tests/support/study.rs"]
+mod study;
+
 mod experiment_config;
 mod protocol_components;
 mod record;

@@ -14,6 +14,8 @@ use hil_core::{
 use hil_experiments::Experiment;
 use hil_experiments::run_recorded;
 
+use crate::demo::lines_without_markers;
+
 fn tmp_dir(name: &str) -> PathBuf {
     // tmpfs where available: these tests fsync thousands of lines, which on
     // a disk costs seconds and tests nothing more.
@@ -112,16 +114,6 @@ fn full_run(path: &Path) -> Vec<hil_core::EpisodeMetrics> {
     seen
 }
 
-/// The log's lines without `resumed` markers.
-fn content(path: &Path) -> Vec<String> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .filter(|l| !l.contains(r#""record":"resumed""#))
-        .map(String::from)
-        .collect()
-}
-
 #[test]
 fn a_recorded_run_matches_an_unrecorded_one() {
     let dir = tmp_dir("plain");
@@ -157,7 +149,7 @@ fn resuming_from_every_cut_point_gives_the_uninterrupted_log() {
     let dir = tmp_dir("cuts");
     let reference_path = dir.join("reference.jsonl");
     let reference_metrics = full_run(&reference_path);
-    let reference = content(&reference_path);
+    let reference = lines_without_markers(&reference_path);
     let bytes = std::fs::read(&reference_path).unwrap();
     // Cut at every line end and in the middle of every line: what a kill at
     // any moment can leave (a step written but not acted on, a torn write...).
@@ -195,7 +187,7 @@ fn resuming_from_every_cut_point_gives_the_uninterrupted_log() {
         })
         .unwrap_or_else(|e| panic!("resume after cut at byte {cut}: {e}"));
         assert_eq!(metrics, reference_metrics, "cut at byte {cut}");
-        assert_eq!(content(&path), reference, "cut at byte {cut}");
+        assert_eq!(lines_without_markers(&path), reference, "cut at byte {cut}");
         let reference_queries = reference
             .iter()
             .filter(|l| l.contains(r#""record":"step""#) && l.contains(r#""response":{"#))

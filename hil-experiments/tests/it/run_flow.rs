@@ -4,57 +4,25 @@
 
 use std::path::{Path, PathBuf};
 
-use hil_core::EventCollector;
+use hil_core::{EventCollector, HilError};
 use hil_experiments::run::{JsonlEvents, Recording, Run};
 
-const CONFIG: &str = r#"
-seed = 5
-episodes = 2
+use crate::demo::{DemoSession, lines_without_markers, scratch_dir};
 
-[session]
-n_att = 3
-
-[environment]
-type = "demo_plate"
-foods = ["banana", "carrot", "grape"]
-repeat = 2
-
-[policy]
-type = "demo_learner"
-query_probability = 0.5
-epsilon = 0.2
-
-[workload]
-type = "demo_counting"
-increment = 0.05
-window = 10
-
-[channel]
-type = "simulated_expert"
-decline_rate = 0.2
-"#;
+/// The session every test here runs.
+fn config_text() -> String {
+    DemoSession::default().toml()
+}
 
 fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hil-run-flow-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    scratch_dir("run-flow", name)
 }
 
 /// Writes the config into `dir` and returns its path.
 fn config(dir: &Path) -> PathBuf {
     let path = dir.join("exp.toml");
-    std::fs::write(&path, CONFIG).unwrap();
+    std::fs::write(&path, config_text()).unwrap();
     path
-}
-
-fn lines_without_markers(path: &Path) -> Vec<String> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .filter(|l| !l.contains(r#""record":"resumed""#))
-        .map(String::from)
-        .collect()
 }
 
 #[test]
@@ -77,7 +45,7 @@ fn a_log_cut_anywhere_resumes_to_the_uninterrupted_run() {
     assert!(lines.len() > 20, "{} lines", lines.len());
     // The header holds the config verbatim and where it was.
     let header: serde_json::Value = serde_json::from_str(&lines[0]).unwrap();
-    assert_eq!(header["config"], CONFIG);
+    assert_eq!(header["config"], config_text());
     let config_path = PathBuf::from(header["config_path"].as_str().unwrap());
     assert!(config_path.is_absolute());
 
@@ -148,4 +116,83 @@ fn a_missing_config_is_an_error_naming_it() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("/nonexistent/exp.toml"), "{e}");
+}
+
+/// `lines` with `edit` applied to each record's JSON text, re-chained as
+/// a forger who knows the format would (the chain has no key).
+fn forge(lines: &[String], mut edit: impl FnMut(usize, String) -> String) -> String {
+    use hil_core::record::chain::{Chain, split};
+    let mut chain = Chain::start();
+    let mut out = String::new();
+    for (i, line) in lines.iter().enumerate() {
+        let (_, content) = split(line).unwrap();
+        out += &chain.seal(&edit(i, content), true);
+        out.push('\n');
+    }
+    out
+}
+
+/// A re-chained log whose episode summary disagrees with its steps, or
+/// whose header's config was changed, is refused on resume, naming the line
+/// and record where the replay departs from it (resuming used to trust
+/// everything before the last checkpoint).
+#[test]
+fn a_forged_summary_or_header_is_refused_on_resume() {
+    let dir = tmp_dir("forged");
+    let config = config(&dir);
+    let full = dir.join("full.jsonl");
+    Run::from_config(&config, Some(&full))
+        .unwrap()
+        .execute(&mut [], |_, _| {})
+        .unwrap();
+    let lines = lines_without_markers(&full);
+    assert!(lines.iter().any(|l| l.contains(r#""record":"checkpoint""#)));
+    let end0 = lines
+        .iter()
+        .position(|l| l.contains(r#""record":"episode_end""#))
+        .unwrap();
+
+    let summary = dir.join("summary.jsonl");
+    std::fs::write(
+        &summary,
+        forge(&lines, |i, content| {
+            if i != end0 {
+                return content;
+            }
+            let at = content.find("\"r_task_avg\":").unwrap() + "\"r_task_avg\":".len();
+            let end = at + content[at..].find([',', '}']).unwrap();
+            format!("{}0.999{}", &content[..at], &content[end..])
+        }),
+    )
+    .unwrap();
+    match Run::resume(&summary).unwrap().execute(&mut [], |_, _| {}) {
+        Err(HilError::Data { record, field, .. }) => {
+            assert_eq!((record, field.as_str()), (end0 + 1, "episode_end"))
+        }
+        other => panic!("{other:?}"),
+    }
+
+    let header = dir.join("header.jsonl");
+    let digest = |cfg: &str| hil_core::record::chain::digest_hex(cfg);
+    let original = config_text();
+    let changed = original.replace("n_att = 3", "n_att = 4");
+    std::fs::write(
+        &header,
+        forge(&lines, |i, content| {
+            if i != 0 {
+                return content;
+            }
+            let edited = content
+                .replace("n_att = 3", "n_att = 4")
+                .replace(&digest(&original), &digest(&changed));
+            assert_ne!(edited, content);
+            edited
+        }),
+    )
+    .unwrap();
+    match Run::resume(&header).unwrap().execute(&mut [], |_, _| {}) {
+        Err(HilError::Data { record, .. }) => assert!(record > 1 && record <= lines.len()),
+        other => panic!("{other:?}"),
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

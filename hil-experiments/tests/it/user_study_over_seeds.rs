@@ -8,16 +8,11 @@ use hil_experiments::user_study::{UserStudyConfig, UserStudyOverSeeds};
 use hil_jobs::Runner;
 use hil_stats::Stat;
 
+use crate::study::food_replay_study;
+
 /// Two methods, one tuned, on the bundled synthetic food dataset.
 fn study() -> UserStudyConfig {
-    UserStudyConfig::parse(
-        r#"
-        repetitions = 1
-        [environment]
-        type = "food_replay"
-        foods = ["banana", "carrot"]
-        pretrain_foods = ["apple", "kiwi", "strawberry"]
-        items_per_episode = 3
+    let methods = r#"
         [validation]
         plates = 2
         [[methods]]
@@ -27,7 +22,9 @@ fn study() -> UserStudyConfig {
         label = "LinUCB-QG"
         policy = { type = "linucb_qg", alpha = 0.5, lambda = 1.0, w = 1.0, pretrain = true }
         tune = { w = [0.5, 8.0] }
-        "#,
+        "#;
+    UserStudyConfig::parse(
+        &food_replay_study(1, r#""banana", "carrot""#, methods),
         Path::new("study.toml"),
     )
     .unwrap()

@@ -5,17 +5,12 @@ use std::path::Path;
 
 use hil_experiments::user_study::UserStudyConfig;
 
+use crate::study::food_replay_study;
+
 #[test]
 fn queries_by_food_and_by_attempt_add_up_to_the_plate_count() {
     let cfg = UserStudyConfig::parse(
-        r#"
-        repetitions = 2
-        [environment]
-        type = "food_replay"
-        foods = ["banana", "carrot"]
-        pretrain_foods = ["apple", "kiwi", "strawberry"]
-        items_per_episode = 3
-        "#,
+        &food_replay_study(2, r#""banana", "carrot""#, ""),
         Path::new("study.toml"),
     )
     .unwrap();

@@ -13,6 +13,8 @@
 //! - [`builtin`]: every built-in component type is linked into any
 //!   program using this crate; [`load_experiment`] reads a config with
 //!   all of them, with no registration call;
+//! - [`grids`]: the grid the paper's published f_q imply, and grid
+//!   variants selected over the same runs;
 //! - [`method`]: a method of either protocol (a labelled policy config,
 //!   built-in or plugin, with an optional tuned hyperparameter);
 //! - [`testbed`]: the paper's simulated-testbed protocol (methods as policy
@@ -27,6 +29,7 @@
 //!   `scripts/setup-mujoco` first), as do its keyframes;
 //! - [`run`]: running an experiment file with its interaction record, and
 //!   resuming one from its log (what `hil run` and hil-py's `hil.run` do);
+//! - [`docs`]: EXPERIMENTS.md written from a run's results;
 //! - [`results`]: selection and aggregation; [`report`]: Markdown tables
 //!   beside the paper's published numbers ([`published`], read from data
 //!   files); [`plot`]: SVG figures; [`output`]: writes them all.
@@ -39,8 +42,10 @@ pub mod builtin;
 pub mod calibrate;
 pub mod claims;
 pub mod components;
+pub mod docs;
 pub mod experiment;
 pub mod experiment_config;
+pub mod grids;
 pub mod method;
 pub mod output;
 pub mod plot;

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use hil_core::{HilError, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::plot::{frontier_svg, rollout_svg, workload_comparison_svg};
 use crate::report::tables_markdown;
@@ -13,7 +13,7 @@ use crate::results::Reproduction;
 use crate::testbed::{NamedModel, Phase, Protocol, RunRecord};
 
 /// Where the time went.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
     /// Building the dataset, models and pretrained estimator.
     pub setup_s: f64,
@@ -31,6 +31,44 @@ struct ResultsFile<'a> {
     results: &'a Reproduction,
     timing: &'a Timing,
     delta_wl_definition: &'static str,
+}
+
+/// `results.json` read back: the reproduction and its timing.
+#[derive(Clone, Debug, Deserialize)]
+pub struct ResultsRead {
+    /// Both runs, the grid variants and the frontier.
+    #[serde(flatten)]
+    pub results: Reproduction,
+    /// Where the time went.
+    pub timing: Timing,
+}
+
+/// The text of `results.json` for `reproduction`.
+pub fn results_json(reproduction: &Reproduction, timing: &Timing) -> Result<String> {
+    serde_json::to_string_pretty(&ResultsFile {
+        results: reproduction,
+        timing,
+        delta_wl_definition: "paper: f(WL_0, Q_T) - WL_0 with the workload model evaluated at the final timestep T over the episode's query history (hil_core::EpisodeMetrics)",
+    })
+    .map_err(|e| HilError::serde("results", e))
+}
+
+/// `tables.md` of `reproduction`: the paper-protocol tables, the many-seed
+/// tables, then the claims ([`crate::claims`]). A function of the results
+/// alone, so EXPERIMENTS.md can be written again from `results.json`.
+pub fn tables_document(reproduction: &Reproduction, timing: &Timing) -> Result<String> {
+    // The time is that of every episode run, so only the run that holds
+    // them all (the many-seed one, if any) states it.
+    let elapsed = Some(timing.runs_s + timing.setup_s);
+    let paper_elapsed = elapsed.filter(|_| reproduction.many_seeds.is_none());
+    let mut md = tables_markdown(&reproduction.paper_protocol, paper_elapsed)?;
+    if let Some(many) = &reproduction.many_seeds {
+        md.push('\n');
+        md.push_str(&tables_markdown(many, elapsed)?);
+    }
+    md.push('\n');
+    md.push_str(&crate::claims::claims_markdown(reproduction)?);
+    Ok(md)
 }
 
 /// The files written.
@@ -54,7 +92,7 @@ impl Written {
     }
 }
 
-fn write(path: &Path, text: &str) -> Result<()> {
+pub(crate) fn write(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|e| HilError::io("writing", path, e))
 }
 
@@ -119,13 +157,7 @@ pub fn report(
 /// Writes `results.json` into `dir`.
 fn write_results(dir: &Path, reproduction: &Reproduction, timing: &Timing) -> Result<PathBuf> {
     let results_path = dir.join("results.json");
-    let json = serde_json::to_string_pretty(&ResultsFile {
-        results: reproduction,
-        timing,
-        delta_wl_definition: "paper: f(WL_0, Q_T) - WL_0 with the workload model evaluated at the final timestep T over the episode's query history (hil_core::EpisodeMetrics)",
-    })
-    .map_err(|e| HilError::serde("results", e))?;
-    write(&results_path, &json)?;
+    write(&results_path, &results_json(reproduction, timing)?)?;
     Ok(results_path)
 }
 
@@ -140,18 +172,7 @@ fn write_tables_and_figures(
 ) -> Result<(PathBuf, Vec<PathBuf>)> {
     std::fs::create_dir_all(dir).map_err(|e| HilError::io("creating", dir, e))?;
     let tables = dir.join("tables.md");
-    // The time is that of every episode run, so only the run that holds
-    // them all (the many-seed one, if any) states it.
-    let elapsed = Some(timing.runs_s + timing.setup_s);
-    let paper_elapsed = elapsed.filter(|_| reproduction.many_seeds.is_none());
-    let mut md = tables_markdown(&reproduction.paper_protocol, paper_elapsed)?;
-    if let Some(many) = &reproduction.many_seeds {
-        md.push('\n');
-        md.push_str(&tables_markdown(many, elapsed)?);
-    }
-    md.push('\n');
-    md.push_str(&crate::claims::claims_markdown(reproduction.headline())?);
-    write(&tables, &md)?;
+    write(&tables, &tables_document(reproduction, timing)?)?;
     let results = reproduction.headline();
 
     let s = &results.settings;

@@ -200,8 +200,12 @@ type Candidate = (GridPoint, Option<usize>);
 /// Candidates of method `i` when the decision model is `m`: one per grid
 /// point, deciding with `m` if the method has runs per deciding model.
 fn candidates(idx: &Index<'_>, s: &ProtocolSettings, i: usize, m: usize) -> Vec<Candidate> {
-    s.methods[i]
-        .grid()
+    candidates_at(idx, s.methods[i].grid(), i, m)
+}
+
+/// [`candidates`] at the grid points `points` of method `i`.
+fn candidates_at(idx: &Index<'_>, points: Vec<GridPoint>, i: usize, m: usize) -> Vec<Candidate> {
+    points
         .into_iter()
         .map(|point| {
             let per_model = idx
@@ -354,7 +358,7 @@ pub struct FrontierPoint {
 }
 
 /// The frontier over every test run in `records`: every (model, method,
-/// grid value).
+/// grid value of any grid variant).
 pub fn frontier(
     settings: &ProtocolSettings,
     models: &[NamedModel],
@@ -366,7 +370,7 @@ pub fn frontier(
     let mut out = Vec::new();
     for (m, model) in models.iter().enumerate() {
         for (i, method) in settings.methods.iter().enumerate() {
-            for cand in candidates(&idx, settings, i, m) {
+            for cand in candidates_at(&idx, settings.run_points(i)?, i, m) {
                 let runs = idx.runs(Phase::Test, i, &cand);
                 let scored = score_all(&runs, model)?;
                 let col = |f: &dyn Fn(&EpisodeMetrics) -> f64| {
@@ -396,6 +400,11 @@ pub struct Reproduction {
     pub many_seeds: Option<ProtocolResults>,
     /// Test r_task against ΔWL for every grid value, over every seed run.
     pub frontier: Vec<FrontierPoint>,
+    /// The headline run (many-seed if any) selected again under each of the
+    /// settings' grid variants, in order: what the claims' robustness
+    /// across grids reads.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub grid_variants: Vec<ProtocolResults>,
 }
 
 impl Reproduction {
@@ -426,11 +435,28 @@ impl Reproduction {
         } else {
             None
         };
+        let (n, spread) = if many_seeds.is_some() {
+            (settings.many_seeds, Spread::Se)
+        } else {
+            (settings.n_seeds, Spread::Std)
+        };
+        let grid_variants = settings
+            .variants()?
+            .iter()
+            .map(|v| aggregate(v, models, records, provenance, n, spread))
+            .collect::<Result<_>>()?;
         Ok(Self {
             paper_protocol,
             many_seeds,
             frontier: frontier(settings, models, records)?,
+            grid_variants,
         })
+    }
+
+    /// The headline results under every grid: the settings' own first, then
+    /// each variant.
+    pub fn by_grid(&self) -> impl Iterator<Item = &ProtocolResults> {
+        std::iter::once(self.headline()).chain(&self.grid_variants)
     }
 
     /// The results with uncertainty: the many-seed run if there is one.

@@ -57,6 +57,7 @@ use crate::components::{
     ConfiguredChannel, ConfiguredEnvironment, DatasetReplay, EpisodeSpec, PerfectExpertChannel,
     SharedChannelFactory, SharedEnvironmentFactory, check_matches_task,
 };
+use crate::grids::{GridVariant, PAPER_IMPLIED, union_points};
 use crate::method::{GridPoint, Method};
 use crate::results::Reproduction;
 use serde::{Deserialize, Serialize};
@@ -87,6 +88,10 @@ pub struct FigureSettings {
     pub rollout: String,
     /// The methods whose workload curves are compared.
     pub workload: Vec<String>,
+}
+
+fn default_grid_name() -> String {
+    "default".into()
 }
 
 /// Most environment or policy seeds a protocol may ask for.
@@ -135,6 +140,13 @@ pub struct ProtocolSettings {
     pub cross_w_task: f64,
     /// What the figures show.
     pub figures: FigureSettings,
+    /// The name of the methods' own grids in tables (e.g. `paper-implied`).
+    #[serde(default = "default_grid_name")]
+    pub grid_name: String,
+    /// Other grids, selected over the same runs (the protocol runs the
+    /// union of every grid once); the claims are checked under each.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub grid_variants: Vec<GridVariant>,
     /// What answers the policies' queries: a query-channel table (`type =
     /// "..."`, any built-in, plugin or Python-registered type, and its
     /// parameters); none: the paper's perfect expert
@@ -152,21 +164,24 @@ pub struct ProtocolSettings {
 impl ProtocolSettings {
     /// The paper's protocol: 3 seeds, 5 policy seeds, N_att = 10,
     /// WL_0 = 0.5, 5 items per episode, w_task ∈ {0.2, …, 0.9}, the four
-    /// methods, f1-on-f2 and f12-on-f2 at w_task = 0.4, on both ends of
-    /// the calibrated simulation models (`f*_sim`, `f*_sim_steep`), with a
-    /// 30-seed run beside it for standard errors. The w and c grids are
-    /// ours (the paper does not list them).
+    /// methods, f1-on-f2 and f12-on-f2 at w_task = 0.4, on the three
+    /// calibrated variants of the simulation models (`f*_sim` lean,
+    /// `f*_sim_mid` middle, `f*_sim_steep`), with a 30-seed run beside it
+    /// for standard errors. ExpDecay's c grid is the one the paper's
+    /// published f_q imply, QG's w grid is ours ([`crate::grids`]); hil's
+    /// own grids run beside them as a grid variant.
     pub fn paper() -> Self {
-        let cross = |decide: &str| CrossSetting {
-            method: LINUCB_QG.into(),
-            decide: decide.into(),
-            score: "f2_sim".into(),
-        };
-        let cross_steep = |decide: &str| CrossSetting {
-            method: LINUCB_QG.into(),
-            decide: End::Steep.model_name(decide),
-            score: End::Steep.model_name("f2_sim"),
-        };
+        // f1-on-f2 and f12-on-f2 at every calibrated variant.
+        let cross = End::ALL
+            .into_iter()
+            .flat_map(|end| {
+                ["f1_sim", "f12_sim"].map(|decide| CrossSetting {
+                    method: LINUCB_QG.into(),
+                    decide: end.model_name(decide),
+                    score: end.model_name("f2_sim"),
+                })
+            })
+            .collect();
         Self {
             plugins: Vec::new(),
             dataset: None,
@@ -183,12 +198,7 @@ impl ProtocolSettings {
             n_policy_seeds: simulation::EXPDECAY_POLICY_SEEDS,
             w_tasks: simulation::W_TASKS.to_vec(),
             methods: PaperMethod::ALL.into_iter().map(Method::paper).collect(),
-            cross: vec![
-                cross("f1_sim"),
-                cross("f12_sim"),
-                cross_steep("f1_sim"),
-                cross_steep("f12_sim"),
-            ],
+            cross,
             cross_w_task: simulation::CROSS_W_TASK,
             figures: FigureSettings {
                 model: "f2_sim".into(),
@@ -200,9 +210,47 @@ impl ProtocolSettings {
                     LINUCB_QG.into(),
                 ],
             },
+            grid_name: PAPER_IMPLIED.into(),
+            grid_variants: vec![GridVariant::hil()],
             channel: None,
             environment: None,
         }
+    }
+
+    /// The paper's protocol with hil's own grids as the headline and the
+    /// paper-implied ones as the variant: the same runs as [`Self::paper`]
+    /// (`examples/configs/paper-protocol-hil-grids.toml`).
+    pub fn paper_with_hil_grids() -> Result<Self> {
+        let mut s = Self::paper().with_grids(&GridVariant::hil())?;
+        s.grid_variants = vec![GridVariant::paper_implied()];
+        Ok(s)
+    }
+
+    /// The same settings with variant `v`'s grids as the methods' own and
+    /// no other variant: what selection and aggregation under `v` read.
+    pub fn with_grids(&self, v: &GridVariant) -> Result<Self> {
+        let mut s = self.clone();
+        s.methods = v.apply(&self.methods)?;
+        s.grid_name.clone_from(&v.name);
+        s.grid_variants.clear();
+        Ok(s)
+    }
+
+    /// The settings under each grid variant, in order ([`Self::with_grids`]).
+    pub fn variants(&self) -> Result<Vec<Self>> {
+        self.grid_variants
+            .iter()
+            .map(|v| self.with_grids(v))
+            .collect()
+    }
+
+    /// Every grid point method `i` is run at: its own grid's and every
+    /// variant's, each once.
+    pub fn run_points(&self, i: usize) -> Result<Vec<GridPoint>> {
+        let variants = self.variants()?;
+        let mut grids = vec![&self.methods[i]];
+        grids.extend(variants.iter().map(|v| &v.methods[i]));
+        Ok(union_points(&grids))
     }
 
     /// A fast smoke version: 3-point grids, 2 policy seeds, a 5-seed run
@@ -217,6 +265,16 @@ impl ProtocolSettings {
                     "c" => vec![0.0, 0.5, 4.0],
                     _ => vec![0.5, 4.0, 32.0],
                 };
+            }
+        }
+        for v in &mut s.grid_variants {
+            for tune in v.tune.values_mut() {
+                for (name, values) in tune.iter_mut() {
+                    *values = match name.as_str() {
+                        "c" => vec![0.0, 0.5, 4.0],
+                        _ => vec![0.5, 4.0, 32.0],
+                    };
+                }
             }
         }
         s
@@ -402,6 +460,22 @@ impl ProtocolSettings {
             }
         }
         self.check_components()?;
+        for v in self.variants()? {
+            for (i, m) in v.methods.iter().enumerate() {
+                for point in m.grid() {
+                    m.config(&point).map_err(|e| {
+                        HilError::invalid_parameter(
+                            format!(
+                                "grid_variants.{}.tune.{}",
+                                v.grid_name, self.methods[i].label
+                            ),
+                            format!("{point:?}"),
+                            e.to_string(),
+                        )
+                    })?;
+                }
+            }
+        }
         for label in std::iter::once(&self.figures.rollout).chain(&self.figures.workload) {
             if self.method(label).is_none() {
                 return Err(HilError::invalid_parameter(
@@ -504,7 +578,7 @@ impl ModelSource {
             file: None,
             config: None,
             paper: match End::split(name) {
-                (base, End::Steep) => Some(base.to_string()),
+                (base, End::Steep | End::Middle) => Some(base.to_string()),
                 (_, End::Lean) => None,
             },
         }
@@ -783,7 +857,7 @@ impl Protocol {
         let s = &self.settings;
         let mut specs: Vec<(usize, GridPoint, Option<usize>, usize)> = Vec::new();
         for (i, m) in s.methods.iter().enumerate() {
-            for point in m.grid() {
+            for point in s.run_points(i)? {
                 let cfg = m.config(&point)?;
                 let n_ps = if cfg.is_stochastic() {
                     s.n_policy_seeds

@@ -1,12 +1,15 @@
 //! Models shipped with the crate.
 //!
-//! - `f1_sim`, `f2_sim`, `f12_sim` and their `_steep` variants: the
-//!   simulation models (Granger H = 10, γ and every w_i in [0.05, 1],
-//!   w_0 ≤ 1), *calibrated* to the paper's published simulation rows, not
-//!   fitted: the rows leave the trade-off between the no-query level and the
-//!   per-query increment open, and the plain names take its lean end, the
-//!   `_steep` names its other end. Regenerate with `hil workload calibrate`
-//!   (derivation: `hil_experiments::calibrate`).
+//! - `f1_sim`, `f2_sim`, `f12_sim` and their `_mid` and `_steep` variants:
+//!   the simulation models (Granger H = 10), *calibrated* to the paper's
+//!   published simulation rows, not fitted: the rows leave the trade-off
+//!   between the no-query level and the per-query increment open. The
+//!   plain names take its lean end and the `_steep` names its other end
+//!   (both in the simulation family: γ and every w_i in [0.05, 1],
+//!   w_0 ≤ 1); the `_mid` names the model with the most even per-query
+//!   response that meets the rows (every weight ≥ 0, no floor; the README
+//!   says why). Regenerate with `hil workload calibrate` (derivation:
+//!   `hil_experiments::calibrate`).
 //! - `f1_real`, `f12_real`: the cross-validation winners on D1 and D12 of
 //!   the bundled synthetic study (`data/synthetic_study.csv`, calibrated to
 //!   the paper's published figures; not real participant data). Regenerate
@@ -23,11 +26,14 @@ use crate::models::FittedModel;
 pub const STUDY_FITTED: [&str; 2] = ["f1_real", "f12_real"];
 
 /// The bundled simulation models calibrated to the paper's published rows
-/// (`hil workload calibrate`), lean ends first.
-pub const CALIBRATED: [&str; 6] = [
+/// (`hil workload calibrate`): lean, then middle, then steep.
+pub const CALIBRATED: [&str; 9] = [
     "f1_sim",
     "f2_sim",
     "f12_sim",
+    "f1_sim_mid",
+    "f2_sim_mid",
+    "f12_sim_mid",
     "f1_sim_steep",
     "f2_sim_steep",
     "f12_sim_steep",
@@ -54,6 +60,9 @@ pub fn json(name: &str) -> Option<&'static str> {
         "f1_sim" => include_str!("../models/f1_sim.json"),
         "f2_sim" => include_str!("../models/f2_sim.json"),
         "f12_sim" => include_str!("../models/f12_sim.json"),
+        "f1_sim_mid" => include_str!("../models/f1_sim_mid.json"),
+        "f2_sim_mid" => include_str!("../models/f2_sim_mid.json"),
+        "f12_sim_mid" => include_str!("../models/f12_sim_mid.json"),
         "f1_sim_steep" => include_str!("../models/f1_sim_steep.json"),
         "f2_sim_steep" => include_str!("../models/f2_sim_steep.json"),
         "f12_sim_steep" => include_str!("../models/f12_sim_steep.json"),

@@ -47,6 +47,10 @@ pub struct ReproduceArgs {
     pub lambda: Option<f64>,
     #[command(flatten)]
     pub threads: super::Threads,
+    /// Also write `docs/results/reproduce.json` and `EXPERIMENTS.md` under
+    /// this repository root (`.` from a checkout), from this run's results.
+    #[arg(long, value_name = "ROOT")]
+    pub write_docs: Option<PathBuf>,
     /// No progress bar or summary.
     #[arg(long, short)]
     pub quiet: bool,
@@ -106,6 +110,10 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
         threads,
     };
     let (reproduction, written) = report(&protocol, &records, Some(&args.out), &mut timing)?;
+    let docs = match &args.write_docs {
+        Some(root) => hil_experiments::docs::write_docs(root, &reproduction, &timing)?,
+        None => Vec::new(),
+    };
 
     if !args.quiet {
         note!(
@@ -147,7 +155,11 @@ pub fn run(args: ReproduceArgs) -> hil_core::Result<()> {
                 }
             }
         }
-        for f in written.iter().flat_map(Written::paths) {
+        for f in written
+            .iter()
+            .flat_map(Written::paths)
+            .chain(docs.iter().map(PathBuf::as_path))
+        {
             outln!("wrote {}", f.display())?;
         }
     }

@@ -55,19 +55,22 @@ fn data_generate_check_then_reproduce_quick() {
     assert!(out.status.success(), "{}", text(&out));
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(res.join("results.json")).unwrap()).unwrap();
-    // 6 calibrated models × 8 w_task × 4 policies, and four cross-data
-    // rows, in the 3-seed protocol and in the many-seed run beside it.
+    // 9 calibrated models (lean, middle, steep) × 8 w_task × 4 policies,
+    // and six cross-data rows, in the 3-seed protocol and in the many-seed
+    // run beside it.
     let paper = &json["paper_protocol"];
     let many = &json["many_seeds"];
     for (run, seeds, spread) in [(paper, 3, "std"), (many, 5, "se")] {
-        assert_eq!(run["rows"].as_array().unwrap().len(), 192);
-        assert_eq!(run["cross"].as_array().unwrap().len(), 4);
+        assert_eq!(run["rows"].as_array().unwrap().len(), 288);
+        assert_eq!(run["cross"].as_array().unwrap().len(), 6);
         assert_eq!(run["n_env_seeds"], seeds);
         assert_eq!(run["spread"], spread);
         assert!(run["provenance"].as_str().unwrap().contains("synthetic"));
     }
-    // Every grid value of every method under every model: 6 × (1 + 1 + 3 + 3).
-    assert_eq!(json["frontier"].as_array().unwrap().len(), 6 * 8);
+    // Every grid value of every method under every model: 9 × (1 + 1 + 3 + 3)
+    // (--quick gives hil's grid variant the same 3-point grids).
+    assert_eq!(json["frontier"].as_array().unwrap().len(), 9 * 8);
+    assert_eq!(json["grid_variants"].as_array().unwrap().len(), 1);
     let tables = std::fs::read_to_string(res.join("tables.md")).unwrap();
     assert!(tables.contains("Table I") && tables.contains("0.292 ± 0.113"));
     assert!(tables.contains("5 seeds (mean ± standard error)"));

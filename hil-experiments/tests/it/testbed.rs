@@ -31,6 +31,7 @@ pub fn setup() -> (Arc<FoodDataset>, ProtocolSettings, Vec<NamedModel>) {
             decide: "slow".into(),
             score: "fast".into(),
         }],
+        grid_variants: Vec::new(),
         ..ProtocolSettings::paper()
     };
     settings.methods[2].tune.insert("c".into(), vec![0.0, 2.0]);
@@ -230,6 +231,58 @@ fn plots_render_runs() {
     let svg = hil_experiments::plot::workload_comparison_svg(&[("a", &rec), ("b", &rec)], m, "n")
         .unwrap();
     assert_eq!(svg.matches("<polyline").count(), 2);
+}
+
+/// A grid variant runs only its extra grid values, and is selected over
+/// the same runs: its results choose only among its own values.
+#[test]
+fn a_grid_variant_runs_its_extra_values_once_and_selects_among_them() {
+    let (ds, mut settings, models) = setup();
+    let base = Protocol::new(settings.clone(), ds.clone(), models.clone())
+        .unwrap()
+        .jobs()
+        .unwrap()
+        .len();
+    // c ∈ {0, 2} by default; the variant: {2, 5} (one new value).
+    settings.grid_variants = vec![hil_experiments::grids::GridVariant {
+        name: "other".into(),
+        tune: [(
+            "LinUCB-ExpDecay".to_string(),
+            [("c".to_string(), vec![2.0, 5.0])].into(),
+        )]
+        .into(),
+    }];
+    let mut p = Protocol::new(settings.clone(), ds, models.clone()).unwrap();
+    // One extra c × 3 policy seeds × 3 seeds × 2 phases.
+    assert_eq!(p.jobs().unwrap().len(), base + 3 * 3 * 2);
+    let r = Reproduction::of(&settings, &models, &run_all(&mut p, 2), "t").unwrap();
+    assert_eq!(r.grid_variants.len(), 1);
+    let v = &r.grid_variants[0];
+    assert_eq!(v.settings.grid_name, "other");
+    for row in v.rows.iter().filter(|x| x.method == "LinUCB-ExpDecay") {
+        let c = row.selected.as_ref().unwrap().value;
+        assert!(c == 2.0 || c == 5.0, "{c}");
+    }
+    for row in r
+        .headline()
+        .rows
+        .iter()
+        .filter(|x| x.method == "LinUCB-ExpDecay")
+    {
+        let c = row.selected.as_ref().unwrap().value;
+        assert!(c == 0.0 || c == 2.0, "{c}");
+    }
+    // An unknown method in a variant is refused before anything runs.
+    settings.grid_variants[0]
+        .tune
+        .insert("Nope".into(), Default::default());
+    let ds = r.headline().settings.load_dataset().unwrap();
+    assert!(settings.validate(&ds, &models).is_err());
+    let p = Protocol::new(settings, ds, models).unwrap();
+    assert!(matches!(
+        p.jobs(),
+        Err(hil_core::HilError::InvalidParameter { .. })
+    ));
 }
 
 /// The many-seed run extends the paper-protocol run's seeds: its first

@@ -56,6 +56,10 @@ fn main() -> ExitCode {
         Command::Study(args) => cmd::study::run(args),
         Command::Plugins(args) => cmd::plugins::run(args),
     };
+    // Every command has dropped its components by now: a plugin object
+    // whose destructor panicked (in `hil reproduce`, `hil demo`, ...) fails
+    // the command instead of passing unnoticed.
+    let result = cmd::plugins::with_destructor_panics(result);
     match result {
         Ok(()) => ExitCode::SUCCESS,
         // A reader that has gone (`hil data check DIR | head -3`) is no

@@ -3,7 +3,7 @@
 //! the one mistake plugin authors actually make (an unchecked index, an
 //! unseeded RNG, a checkpoint that forgets the RNG).
 //!
-//! They exist to show that every check can fail: hil-core's tests run each
+//! They exist to show that every check can fail: this crate's tests run each
 //! one through its suite and assert that exactly the named check fails
 //! ([`PolicyDefect::breaks`] and friends). With no defect each is a
 //! conforming implementation, which passes every property.
@@ -100,6 +100,19 @@ defects! {
         CheckpointForgetsRng => Checkpoint,
         /// Panics in `save` (under the panic guard): a failure, not a skip.
         PanicsInSave => Checkpoint,
+        /// `restore` leaves its step counter as it was: the state saved
+        /// after restoring differs at the key `steps`.
+        RestoreSkipsSteps => Checkpoint,
+        /// `decide` fails on its 50th call (a buffer that fills up): only a
+        /// long trajectory finds it.
+        FailsOnCall50 => PolicyDecides,
+        /// Its destructor panics (under the panic guard, as a plugin's).
+        PanicsInDrop => Destructor,
+        /// Panics in `seed` (under the panic guard), which poisons it.
+        PanicsInSeed => PolicyDecides,
+        /// A value `restore` replaces panics in its destructor, inside
+        /// `restore` (under the panic guard).
+        DropPanicsInRestore => Checkpoint,
     }
 }
 
@@ -130,6 +143,10 @@ defects! {
         ConsumesBeforeValidating => ExecuteRejectsArmOutOfRange,
         /// Keeps no call order: observes item 0 before `next_item`.
         IgnoresCallOrder => OutOfOrderCalls,
+        /// `execute` fails on its 50th call in the instance's life.
+        FailsOnCall50 => EpisodeRuns,
+        /// Its destructor panics.
+        PanicsInDrop => Destructor,
     }
 }
 
@@ -146,6 +163,11 @@ defects! {
         Stateful => DeterministicPrediction,
         /// `predict_if_queried` adds its own increment.
         WrongCounterfactual => Counterfactual,
+        /// Keeps the last 50 queries in a fixed buffer and fails once a
+        /// history holds more: only a long history finds it.
+        FailsAfter50Queries => Predicts,
+        /// Its destructor panics.
+        PanicsInDrop => Destructor,
     }
 }
 
@@ -162,6 +184,10 @@ defects! {
         InconsistentAnswer => AnswerConsistent,
         /// Answers with randomness no seed reaches.
         Unseeded => SeededReplay,
+        /// `ask` fails on its 50th call.
+        FailsOnCall50 => Answers,
+        /// Its destructor panics.
+        PanicsInDrop => Destructor,
     }
 }
 
@@ -191,7 +217,16 @@ pub fn policy(defect: Option<PolicyDefect>, opts: &CheckOptions) -> Result<Box<d
         rng: ChaCha8Rng::seed_from_u64(0),
         steps: 0,
     };
-    if matches!(defect, Some(D::PanicsOnLongerContext | D::PanicsInSave)) {
+    if matches!(
+        defect,
+        Some(
+            D::PanicsOnLongerContext
+                | D::PanicsInSave
+                | D::PanicsInDrop
+                | D::PanicsInSeed
+                | D::DropPanicsInRestore
+        )
+    ) {
         Ok(Box::new(GuardedPolicy::new(
             Box::new(p),
             in_process(),
@@ -241,6 +276,10 @@ impl Policy for EpsilonGreedy {
         self.dim
     }
     fn seed(&mut self, seed: u64) {
+        assert!(
+            !self.is(PolicyDefect::PanicsInSeed),
+            "the seed does not fit the generator"
+        );
         self.seed = seed;
         self.rng = ChaCha8Rng::seed_from_u64(seed);
     }
@@ -263,6 +302,9 @@ impl Policy for EpsilonGreedy {
         self.steps += 1;
         if self.is(D::DecideFails) && self.steps > 3 {
             return Err(HilError::state("broken_policy", "ran out of patience"));
+        }
+        if self.is(D::FailsOnCall50) && self.steps == 50 {
+            return Err(HilError::state("broken_policy", "the step buffer is full"));
         }
         let rate = |(s, n): (f64, f64)| s / n;
         let rates: Vec<f64> = self
@@ -351,6 +393,8 @@ impl Policy for EpsilonGreedy {
             word_pos: String,
             steps: u64,
         }
+        // What restore replaces; for the defect, its destructor panics.
+        let _replaced = Replaced(self.is(PolicyDefect::DropPanicsInRestore));
         let s: S =
             serde_json::from_value(state).map_err(|e| HilError::serde("broken_policy state", e))?;
         if s.counts.len() != self.n_arms {
@@ -366,8 +410,34 @@ impl Policy for EpsilonGreedy {
         self.counts = s.counts;
         self.seed(s.seed);
         self.rng.set_word_pos(pos);
-        self.steps = s.steps;
+        if !self.is(PolicyDefect::RestoreSkipsSteps) {
+            self.steps = s.steps;
+        }
         Ok(())
+    }
+}
+
+/// The destructor of every broken type: panics for the defect
+/// `PanicsInDrop`.
+fn drop_panics(panics: bool) {
+    // Not while unwinding already: that would abort the test process.
+    if panics && !std::thread::panicking() {
+        panic!("the destructor could not release its resources");
+    }
+}
+
+/// Part of a policy's state that `restore` replaces (and so drops).
+struct Replaced(bool);
+
+impl Drop for Replaced {
+    fn drop(&mut self) {
+        drop_panics(self.0);
+    }
+}
+
+impl Drop for EpsilonGreedy {
+    fn drop(&mut self) {
+        drop_panics(self.is(PolicyDefect::PanicsInDrop));
     }
 }
 
@@ -391,6 +461,7 @@ pub fn environment(defect: Option<EnvironmentDefect>) -> Result<Box<dyn Environm
         next: 0,
         current: None,
         order: CallOrder::new("broken_environment"),
+        executed: 0,
     };
     Ok(Box::new(GuardedEnvironment::new(
         Box::new(env),
@@ -407,6 +478,14 @@ struct TableEnv {
     next: usize,
     current: Option<Item>,
     order: CallOrder,
+    /// Calls of `execute` in the instance's life (not reset by `reset`).
+    executed: u64,
+}
+
+impl Drop for TableEnv {
+    fn drop(&mut self) {
+        drop_panics(self.is(EnvironmentDefect::PanicsInDrop));
+    }
 }
 
 impl TableEnv {
@@ -482,6 +561,13 @@ impl Environment for TableEnv {
     }
     fn execute(&mut self, arm: ArmId) -> Result<Outcome> {
         use EnvironmentDefect as D;
+        self.executed += 1;
+        if self.is(D::FailsOnCall50) && self.executed == 50 {
+            return Err(HilError::backend(
+                "broken_environment",
+                "the simulator's log is full",
+            ));
+        }
         let mut arm = arm.0;
         match self.defect {
             Some(D::AcceptsArmOutOfRange) => {
@@ -543,6 +629,12 @@ struct Counting {
     calls: AtomicU64,
 }
 
+impl Drop for Counting {
+    fn drop(&mut self) {
+        drop_panics(self.defect == Some(WorkloadDefect::PanicsInDrop));
+    }
+}
+
 impl WorkloadModel for Counting {
     fn name(&self) -> &str {
         "broken_workload"
@@ -554,6 +646,12 @@ impl WorkloadModel for Counting {
         match self.defect {
             Some(D::PredictFails) if n > 5 => {
                 return Err(HilError::invalid_input("history", "too long"));
+            }
+            Some(D::FailsAfter50Queries) if input.history.len() > 50 => {
+                return Err(HilError::invalid_input(
+                    "history",
+                    "more queries than the buffer of 50",
+                ));
             }
             Some(D::NanOnEmptyHistory) if n == 0 => wl = f64::NAN,
             Some(D::InfiniteOnLongHistories) if n > 20 => wl = f64::INFINITY,
@@ -587,6 +685,7 @@ pub fn query_channel(defect: Option<ChannelDefect>) -> Result<Box<dyn QueryChann
     let ch = NoisyExpert {
         defect,
         rng: ChaCha8Rng::seed_from_u64(0),
+        asked: 0,
     };
     Ok(Box::new(GuardedChannel::new(
         Box::new(ch),
@@ -599,6 +698,14 @@ pub fn query_channel(defect: Option<ChannelDefect>) -> Result<Box<dyn QueryChann
 struct NoisyExpert {
     defect: Option<ChannelDefect>,
     rng: ChaCha8Rng,
+    /// Calls of `ask` in the instance's life.
+    asked: u64,
+}
+
+impl Drop for NoisyExpert {
+    fn drop(&mut self) {
+        drop_panics(self.defect == Some(ChannelDefect::PanicsInDrop));
+    }
 }
 
 impl QueryChannel for NoisyExpert {
@@ -610,7 +717,10 @@ impl QueryChannel for NoisyExpert {
     }
     fn ask(&mut self, query: &Query) -> Result<Response> {
         use ChannelDefect as D;
-        if self.defect == Some(D::AskFails) {
+        self.asked += 1;
+        if self.defect == Some(D::AskFails)
+            || (self.defect == Some(D::FailsOnCall50) && self.asked == 50)
+        {
             return Err(HilError::channel("broken_channel", "the person left"));
         }
         let n = if self.defect == Some(D::AssumesSixActions) {

@@ -2,17 +2,14 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::{Check, CheckOptions, Checker, ConformanceFailure, ConformanceReport, random_context};
-use hil_core::{
-    ArmId, Difficulty, Distraction, Item, Query, QueryChannel, QueryKind, Response, ResponseType,
-};
-
-type Make<'a> = &'a dyn Fn() -> hil_core::Result<Box<dyn QueryChannel>>;
+use hil_core::{ArmId, Item, Query, QueryChannel, QueryKind, Response};
 
 /// Runs the query-channel checks that one instance allows: asks `n`
 /// queries covering every response type, difficulty and distraction (over
 /// the default options' six task-neutral actions, with an oracle answer
-/// set, as a simulated environment would). Seeded replay needs a second
-/// instance: prefer [`check_query_channel_with`], which builds them.
+/// set, as a simulated environment would). Seeded replay, the long run and
+/// the destructor check need instances of the suite's own: prefer
+/// [`check_query_channel_with`], which builds them.
 ///
 /// Channels that need a person (terminal, web) are checked with a scripted
 /// person on the other side by their own tests.
@@ -22,7 +19,7 @@ pub fn check_query_channel(
 ) -> Result<ConformanceReport, ConformanceFailure> {
     let opts = CheckOptions::default().with_queries(n.max(1));
     let mut c = Checker::new(channel.name(), None);
-    answers(&mut c, channel, &opts)?;
+    answers(&mut c, channel, &opts, opts.queries())?;
     c.skip(
         Check::SeededReplay,
         "checked on one instance; check_query_channel_with builds two".into(),
@@ -30,46 +27,46 @@ pub fn check_query_channel(
     Ok(c.finish())
 }
 
-/// Runs every query-channel property on channels built by `make`, stopping
-/// at the first failure.
-///
-/// Properties, over `opts.queries()` queries covering every response type,
-/// difficulty and distraction, asked over `opts.actions()` with contexts
-/// of `opts.context_dim()`: [`Check::ExpertArmInRange`] (the query's own
-/// action space, not a fixed task's), [`Check::ResponseTime`],
-/// [`Check::AnswerConsistent`] and [`Check::SeededReplay`] (two instances
-/// seeded alike give the same answers and expert arms; response times are
-/// not compared, as a human channel measures them).
-pub fn check_query_channel_with(
-    make: Make<'_>,
-    opts: &CheckOptions,
-) -> Result<ConformanceReport, ConformanceFailure> {
-    run(make, opts, None)
+entry_points! {
+    QueryChannel,
+    /// Runs every query-channel property on channels built by `make`, stopping
+    /// at the first failure.
+    ///
+    /// Properties, over queries covering every response type, difficulty and
+    /// distraction, asked over `opts.actions()` with contexts of
+    /// `opts.context_dim()`: [`Check::ExpertArmInRange`] (the query's own
+    /// action space, not a fixed task's), [`Check::ResponseTime`] and
+    /// [`Check::AnswerConsistent`] over a long run of one instance (`opts.steps()`
+    /// queries, 300 by default, or `opts.queries()` if more: a channel that
+    /// fails on its 50th query fails); [`Check::SeededReplay`] (a second instance
+    /// seeded alike gives the same answers and expert arms to the first
+    /// `opts.queries()` queries; response times are not compared, as a human
+    /// channel measures them); and [`Check::Destructor`].
+    check_query_channel_with,
+    /// Runs one query-channel property alone (see [`check_query_channel_with`]).
+    check_query_channel_only,
 }
 
-/// Runs one query-channel property alone (see [`check_query_channel_with`]).
-pub fn check_query_channel_only(
-    make: Make<'_>,
-    opts: &CheckOptions,
-    property: Check,
-) -> Result<ConformanceReport, ConformanceFailure> {
-    run(make, opts, Some(property))
-}
-
-fn run(
-    make: Make<'_>,
-    opts: &CheckOptions,
-    only: Option<Check>,
-) -> Result<ConformanceReport, ConformanceFailure> {
+fn suite(started: super::Started<'_, dyn QueryChannel>, opts: &CheckOptions) -> super::SuiteResult {
     let super::Started {
         make,
         first: mut a,
         checker: mut c,
-    } = super::start(make, opts, only)?;
-    let ra = answers(&mut c, a.as_mut(), opts)?;
+    } = started;
+    let per_answer = [
+        Check::ExpertArmInRange,
+        Check::ResponseTime,
+        Check::AnswerConsistent,
+    ];
+    let long = if c.wants_any(&per_answer) {
+        opts.steps().max(opts.queries())
+    } else {
+        opts.queries()
+    };
+    let ra = answers(&mut c, a.as_mut(), opts, long)?;
     if c.wants(Check::SeededReplay) {
         let mut b = c.ok(Check::Build, make())?;
-        let rb = answers(&mut c, b.as_mut(), opts)?;
+        let rb = answers(&mut c, b.as_mut(), opts, opts.queries())?;
         let same =
             |x: &Response, y: &Response| x.answer == y.answer && x.expert_arm == y.expert_arm;
         let first = ra.iter().zip(&rb).position(|(x, y)| !same(x, y));
@@ -98,23 +95,19 @@ fn query(i: usize, kind: QueryKind, opts: &CheckOptions, rng: &mut ChaCha8Rng) -
     .with_oracle_best(best)
 }
 
-/// Seeds `channel` with 5 and asks the options' queries; checks each answer.
+/// Seeds `channel` with 5 and asks `n` queries; checks each answer.
 fn answers(
     c: &mut Checker,
     channel: &mut dyn QueryChannel,
     opts: &CheckOptions,
+    n: usize,
 ) -> Result<Vec<Response>, ConformanceFailure> {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     channel.seed(5);
     let n_actions = opts.actions().len();
-    let mut out = Vec::with_capacity(opts.queries());
-    for i in 0..opts.queries() {
-        let kind = QueryKind {
-            response: ResponseType::ALL[i % 3],
-            difficulty: Difficulty::ALL[(i / 3) % 2],
-            distraction: Distraction::ALL[(i / 6) % 3],
-        };
-        let q = query(i, kind, opts, &mut rng);
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let q = query(i, super::query_kind(i), opts, &mut rng);
         let r = c.ok(Check::Answers, channel.ask(&q))?;
         c.check(
             Check::ExpertArmInRange,

@@ -102,6 +102,10 @@ pub enum Check {
     AnswerConsistent,
     /// Query channel: two instances seeded alike answer the same queries alike.
     SeededReplay,
+
+    /// Every trait: no object the suite built panics when it is dropped
+    /// (a plugin's guard catches such a panic and hands it to the host).
+    Destructor,
 }
 
 impl Check {
@@ -139,6 +143,7 @@ impl Check {
         Check::ResponseTime,
         Check::AnswerConsistent,
         Check::SeededReplay,
+        Check::Destructor,
     ];
 
     /// The checks of `subject` that are properties (not prerequisites), in
@@ -147,8 +152,16 @@ impl Check {
         Self::ALL
             .iter()
             .copied()
-            .filter(|c| c.subject() == Some(subject) && !c.is_prerequisite())
+            .filter(|c| c.applies_to(subject) && !c.is_prerequisite())
             .collect()
+    }
+
+    /// Whether the suite of `subject` runs this check.
+    pub fn applies_to(self, subject: Subject) -> bool {
+        match self {
+            Check::Build | Check::Destructor => true,
+            other => other.subject() == Some(subject),
+        }
     }
 
     /// Whether every property needs this check on the way (so it is never
@@ -164,11 +177,13 @@ impl Check {
         )
     }
 
-    /// The trait the check belongs to (`None` for [`Check::Build`], shared).
+    /// The trait the check belongs to (`None` for [`Check::Build`] and
+    /// [`Check::Destructor`], which every suite runs: see
+    /// [`Check::applies_to`]).
     pub fn subject(self) -> Option<Subject> {
         use Check::*;
         Some(match self {
-            Build => return None,
+            Build | Destructor => return None,
             PolicyShape
             | PolicyDecides
             | ArmInRange
@@ -237,6 +252,7 @@ impl Check {
             ResponseTime => "response time",
             AnswerConsistent => "answer consistent",
             SeededReplay => "seeded replay",
+            Destructor => "drop does not panic",
         }
     }
 
@@ -245,10 +261,10 @@ impl Check {
         use Check::*;
         match self {
             Build => {
-                "the factory refused its parameters or build context; check the parameters it was given (`--params` for `hil plugins check`) and that it reads the action space and context dimension from the BuildContext"
+                "the factory refused its parameters or its context; check the parameters it was given (`--params` for `hil plugins check`), and that a policy or query channel reads the action space and context dimension from its TaskContext (ctx.action_space(), ctx.context_dim())"
             }
             PolicyShape => {
-                "the policy sizes itself from something other than the build context; take n_arms from ctx.action_space and dim from ctx.context_dim, and refuse (with an error) a context without them"
+                "the policy sizes itself from something other than its TaskContext; take n_arms from ctx.action_space().len() and dim from ctx.context_dim()"
             }
             PolicyDecides => {
                 "decide or observe failed on valid input; validate with hil_core::policy::check_input/check_feedback and do not error on ordinary values"
@@ -338,7 +354,40 @@ impl Check {
             SeededReplay => {
                 "the channel draws from randomness not reseeded by QueryChannel::seed; derive every draw from an RNG seeded there"
             }
+            Destructor => {
+                "the type's Drop implementation (or a field's) panicked when the object was dropped; a destructor cannot return an error, so release what it holds without unwrap/expect/indexing and ignore or log a failure there"
+            }
         }
+    }
+
+    /// Whether [`Check::hint`] is already about a panic in the call the
+    /// check makes (a refusal check, where panicking is the usual mistake);
+    /// for the others a panic gets [`panic_hint`] instead.
+    pub(crate) fn hint_covers_panics(self) -> bool {
+        matches!(
+            self,
+            Check::RejectsWrongDimension
+                | Check::RejectsArmOutOfRange
+                | Check::ExecuteRejectsArmOutOfRange
+                | Check::OutOfOrderCalls
+                | Check::Destructor
+        )
+    }
+}
+
+/// The likely cause and fix of a failure caused by a panic in `method`
+/// (as the panic guard names it).
+pub(crate) fn panic_hint(method: &str) -> String {
+    match method {
+        "drop" => Check::Destructor.hint().to_string(),
+        "restore" => "restore panicked (its message and location are in the detail); if it panicked while dropping the value it replaced (`*self = restored` runs the old value's Drop), fix that Drop; otherwise return HilError::State for a checkpoint restore cannot read, instead of unwrapping".to_string(),
+        "factory" => "the factory panicked (its message and location are in the detail); return an error (HilError::InvalidParameter and friends) for parameters it cannot use".to_string(),
+        "seed" | "best_action" | "current_item" | "name/n_arms/dim" | "name/action_space/context_dim" | "name" => format!(
+            "`{method}` panicked (its message and location are in the detail); it cannot return an error, so the guard poisoned the object and every later call failed: make `{method}` unable to panic (no unwrap/expect/indexing that can fail)"
+        ),
+        _ => format!(
+            "`{method}` panicked instead of returning an error (its message and location are in the detail); fix what the panic points at, and return a HilError for input the method cannot handle"
+        ),
     }
 }
 

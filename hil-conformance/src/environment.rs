@@ -22,46 +22,45 @@ pub fn check_environment(
     )
 }
 
-/// Runs every environment property on environments built by `make`,
-/// stopping at the first failure.
-///
-/// Properties: [`Check::EnvironmentShape`]; over three episodes of seed 11
-/// (two instances, and one of them reset again) [`Check::EpisodeHasItems`],
-/// [`Check::EpisodesEnd`], [`Check::CurrentItem`],
-/// [`Check::ContextDimension`], [`Check::SuccessProbability`],
-/// [`Check::BestActionInRange`] and [`Check::Replayable`];
-/// [`Check::ExecuteRejectsArmOutOfRange`] (refused with
-/// [`HilError::ArmOutOfRange`], and the attempt can still be executed,
-/// with the outcome of an instance that never saw the bad arm); and
-/// [`Check::OutOfOrderCalls`] (`observe` and `execute` before `next_item`,
-/// and `execute` before `observe`, refused with [`HilError::State`]; a
-/// later `reset` replays the episode).
-pub fn check_environment_with(
-    make: Make<'_>,
-    opts: &CheckOptions,
-) -> Result<ConformanceReport, ConformanceFailure> {
-    run(make, opts, None)
+entry_points! {
+    Environment,
+    /// Runs every environment property on environments built by `make`,
+    /// stopping at the first failure.
+    ///
+    /// Properties: [`Check::EnvironmentShape`]; over a long trajectory (episodes
+    /// of consecutive seeds on one instance until `opts.steps()` attempts, 300
+    /// by default, are executed, so an environment that fails on its 50th call
+    /// fails) and three episodes of seed 11 (two instances, and one of them
+    /// reset again) [`Check::EpisodeHasItems`],
+    /// [`Check::EpisodesEnd`], [`Check::CurrentItem`],
+    /// [`Check::ContextDimension`], [`Check::SuccessProbability`],
+    /// [`Check::BestActionInRange`] and [`Check::Replayable`];
+    /// [`Check::ExecuteRejectsArmOutOfRange`] (refused with
+    /// [`HilError::ArmOutOfRange`], and the attempt can still be executed,
+    /// with the outcome of an instance that never saw the bad arm); and
+    /// [`Check::OutOfOrderCalls`] (`observe` and `execute` before `next_item`,
+    /// and `execute` before `observe`, refused with [`HilError::State`]; a
+    /// later `reset` replays the episode); and [`Check::Destructor`].
+    check_environment_with,
+    /// Runs one environment property alone (see [`check_environment_with`]).
+    check_environment_only,
 }
 
-/// Runs one environment property alone (see [`check_environment_with`]).
-pub fn check_environment_only(
-    make: Make<'_>,
-    opts: &CheckOptions,
-    property: Check,
-) -> Result<ConformanceReport, ConformanceFailure> {
-    run(make, opts, Some(property))
-}
+/// The checks made at every step of an episode.
+const STEP_CHECKS: [Check; 5] = [
+    Check::EpisodesEnd,
+    Check::CurrentItem,
+    Check::ContextDimension,
+    Check::SuccessProbability,
+    Check::BestActionInRange,
+];
 
-fn run(
-    make: Make<'_>,
-    opts: &CheckOptions,
-    only: Option<Check>,
-) -> Result<ConformanceReport, ConformanceFailure> {
+fn suite(started: super::Started<'_, dyn Environment>, opts: &CheckOptions) -> super::SuiteResult {
     let super::Started {
         make,
         first: mut a,
         checker: mut c,
-    } = super::start(make, opts, only)?;
+    } = started;
     let build = |c: &Checker| c.ok(Check::Build, make());
     let n_arms = a.action_space().len();
     let dim = a.context_dim();
@@ -78,6 +77,16 @@ fn run(
     c.check(Check::EpisodeHasItems, !ea.is_empty(), || {
         "reset(11) gave an episode without items".into()
     })?;
+    if c.wants_any(&STEP_CHECKS) && !ea.is_empty() {
+        // The long trajectory: episodes of seeds 12, 13, ... on the same
+        // instance until `opts.steps()` attempts have been executed.
+        let mut executed = attempts_in(&ea);
+        let mut seed = 12;
+        while executed < opts.steps() {
+            executed += attempts_in(&run_episode(&mut c, a.as_mut(), seed, attempts)?);
+            seed += 1;
+        }
+    }
     if c.wants(Check::Replayable) {
         let mut b = build(&c)?;
         let eb = run_episode(&mut c, b.as_mut(), 11, attempts)?;
@@ -160,6 +169,11 @@ fn run(
 }
 
 type Trace = Vec<(Item, Vec<(Context, Option<ArmId>, Outcome)>)>;
+
+/// How many attempts an episode executed.
+fn attempts_in(trace: &Trace) -> usize {
+    trace.iter().map(|(_, steps)| steps.len()).sum()
+}
 
 /// Where two traces first differ, for failure messages.
 fn first_difference(a: &Trace, b: &Trace) -> String {

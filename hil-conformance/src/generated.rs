@@ -74,6 +74,7 @@ macro_rules! conformance_tests {
             rejects_arm_out_of_range => RejectsArmOutOfRange,
             rejection_has_no_effect => RejectionHasNoEffect,
             checkpoint => Checkpoint,
+            drop_does_not_panic => Destructor,
         ]);
     };
     (environment $name:ident { options: $opts:expr, make: $make:expr $(,)? }) => {
@@ -88,6 +89,7 @@ macro_rules! conformance_tests {
             replayable => Replayable,
             execute_rejects_arm_out_of_range => ExecuteRejectsArmOutOfRange,
             out_of_order_calls => OutOfOrderCalls,
+            drop_does_not_panic => Destructor,
         ]);
     };
     (query_channel $name:ident { options: $opts:expr, make: $make:expr $(,)? }) => {
@@ -96,14 +98,16 @@ macro_rules! conformance_tests {
             response_time => ResponseTime,
             answer_consistent => AnswerConsistent,
             seeded_replay => SeededReplay,
+            drop_does_not_panic => Destructor,
         ]);
     };
     (workload_model $name:ident { options: $opts:expr, make: $make:expr $(,)? }) => {
-        $crate::__conformance_tests!(@model $name, $opts, $make, [
+        $crate::__conformance_tests!(@factory $name, $opts, $make, WorkloadModel, check_workload_model_built_only, WorkloadModel, [
             empty_history => EmptyHistory,
             finite => FinitePrediction,
             deterministic => DeterministicPrediction,
             counterfactual => Counterfactual,
+            drop_does_not_panic => Destructor,
         ]);
     };
 }
@@ -132,30 +136,6 @@ macro_rules! __conformance_tests {
             }
 
             $crate::__conformance_tests!(@tests $subject, [$($test => $check),*]);
-        }
-    };
-    (@model $name:ident, $opts:expr, $make:expr, [$($test:ident => $check:ident),* $(,)?]) => {
-        #[allow(unused_imports, clippy::redundant_closure)]
-        mod $name {
-            use super::*;
-
-            fn run(
-                property: $crate::Check,
-            ) -> ::std::result::Result<
-                $crate::ConformanceReport,
-                $crate::ConformanceFailure,
-            > {
-                let opts: $crate::CheckOptions = $opts;
-                let make: &dyn Fn(
-                    &$crate::CheckOptions,
-                ) -> $crate::__core::Result<::std::boxed::Box<dyn $crate::__core::WorkloadModel>> = &$make;
-                let model = make(&opts).map_err(|e| {
-                    $crate::ConformanceFailure::of_factory("workload model", &e)
-                })?;
-                $crate::check_workload_model_only(model.as_ref(), &opts, property)
-            }
-
-            $crate::__conformance_tests!(@tests WorkloadModel, [$($test => $check),*]);
         }
     };
     (@tests $subject:ident, [$($test:ident => $check:ident),*]) => {

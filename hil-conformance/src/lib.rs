@@ -17,7 +17,12 @@
 //! The suites are strict: a refusal must be the error kind the contract
 //! names (a dimension mismatch, an arm out of range, a call out of order),
 //! and a panic (which a plugin's guard turns into [`HilError::Plugin`]) is a
-//! failure, never a refusal. [`crate::conformance_tests!`] expands into one
+//! failure, never a refusal, whose hint is about the method that panicked
+//! ([`ConformanceFailure::panicked_in`]). Every suite drives one long
+//! trajectory ([`CheckOptions::with_steps`], 300 steps by default), so a
+//! component that fails on its 50th call fails, and every factory-driven
+//! suite checks that no object it built panics when dropped
+//! ([`Check::Destructor`]). [`crate::conformance_tests!`] expands into one
 //! `#[test]` per property, so a failing test names the property;
 //! [`broken`] holds a deliberately broken implementation for every check.
 //!
@@ -27,6 +32,30 @@
 //! [`strategies`] has proptest strategies (contexts, query histories,
 //! positive-definite matrices), and [`cdylib`] builds plugin libraries
 //! from tests.
+
+/// The two public entry points of a factory-driven suite: every property
+/// (`$with`), or one (`$only`), both through [`run_suite`] with the
+/// module's `suite` function.
+macro_rules! entry_points {
+    ($trait:ident, $(#[$with_doc:meta])* $with:ident, $(#[$only_doc:meta])* $only:ident $(,)?) => {
+        $(#[$with_doc])*
+        pub fn $with(
+            make: &dyn Fn() -> hil_core::Result<Box<dyn hil_core::$trait>>,
+            opts: &$crate::CheckOptions,
+        ) -> Result<$crate::ConformanceReport, $crate::ConformanceFailure> {
+            $crate::run_suite(make, opts, None, suite)
+        }
+
+        $(#[$only_doc])*
+        pub fn $only(
+            make: &dyn Fn() -> hil_core::Result<Box<dyn hil_core::$trait>>,
+            opts: &$crate::CheckOptions,
+            property: $crate::Check,
+        ) -> Result<$crate::ConformanceReport, $crate::ConformanceFailure> {
+            $crate::run_suite(make, opts, Some(property), suite)
+        }
+    };
+}
 
 pub mod broken;
 pub mod cdylib;
@@ -48,7 +77,10 @@ pub use environment::{check_environment, check_environment_only, check_environme
 pub use generated::assert_conforms;
 pub use options::CheckOptions;
 pub use policy::{check_policy, check_policy_only, check_policy_with};
-pub use workload::{check_workload_model, check_workload_model_only, check_workload_model_with};
+pub use workload::{
+    check_workload_model, check_workload_model_built_only, check_workload_model_built_with,
+    check_workload_model_only, check_workload_model_with,
+};
 
 use hil_core::HilError;
 
@@ -59,10 +91,11 @@ pub use hil_core as __core;
 
 /// A conformance check that failed.
 ///
-/// Match on [`ConformanceFailure::check`]; the message adds what was
-/// observed and [`Check::hint`] (the likely cause and the fix).
+/// Match on [`ConformanceFailure::check`] (and
+/// [`ConformanceFailure::panicked_in`]); the message adds what was observed
+/// and [`ConformanceFailure::hint`] (the likely cause and the fix).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("conformance check `{check}` failed for `{subject}`: {detail}\n  likely cause and fix: {}", check.hint())]
+#[error("conformance check `{check}` failed for `{subject}`: {detail}\n  likely cause and fix: {}", self.hint())]
 pub struct ConformanceFailure {
     /// The implementation under test.
     pub subject: String,
@@ -70,6 +103,21 @@ pub struct ConformanceFailure {
     pub check: Check,
     /// What was observed.
     pub detail: String,
+    /// The method whose panic caused the failure (as the panic guard names
+    /// it: `decide`, `seed`, `drop`, `factory`, ...), if a panic did.
+    pub panicked_in: Option<String>,
+}
+
+impl ConformanceFailure {
+    /// The likely cause and fix: the check's [`Check::hint`], or, when a
+    /// panic caused the failure and the check's hint is not about panics,
+    /// what to do about a panic in that method.
+    pub fn hint(&self) -> String {
+        match &self.panicked_in {
+            Some(method) if !self.check.hint_covers_panics() => check::panic_hint(method),
+            _ => self.check.hint().to_string(),
+        }
+    }
 }
 
 /// What a conformance run covered.
@@ -118,6 +166,11 @@ impl Checker {
         check.is_prerequisite() || self.only.is_none_or(|o| o == check)
     }
 
+    /// Whether any of `checks` is part of this run.
+    pub(crate) fn wants_any(&self, checks: &[Check]) -> bool {
+        checks.iter().any(|&c| self.wants(c))
+    }
+
     pub(crate) fn check(
         &mut self,
         check: Check,
@@ -142,6 +195,21 @@ impl Checker {
             subject: self.report.subject.clone(),
             check,
             detail,
+            panicked_in: None,
+        }
+    }
+
+    /// A failure of `check` caused by the error `e` (a guarded panic's
+    /// method is kept, so the hint is about the panic).
+    pub(crate) fn fail_with(
+        &self,
+        check: Check,
+        detail: String,
+        e: &HilError,
+    ) -> ConformanceFailure {
+        ConformanceFailure {
+            panicked_in: hil_plugin::panicked_in(e),
+            ..self.fail(check, detail)
         }
     }
 
@@ -153,7 +221,7 @@ impl Checker {
         check: Check,
         r: hil_core::Result<T>,
     ) -> Result<T, ConformanceFailure> {
-        r.map_err(|e| self.fail(check, describe_error(&e)))
+        r.map_err(|e| self.fail_with(check, describe_error(&e), &e))
     }
 
     /// Checks that `r` is an error for which `expected` holds; `call` says
@@ -173,7 +241,8 @@ impl Checker {
             Err(e) if expected(e) => return self.check(check, true, String::new),
             Ok(v) => format!("{call} was accepted (returned {v:?}); expected {kind}"),
             Err(e @ HilError::Plugin { .. }) => {
-                format!("{call} panicked instead of returning {kind}: {e}")
+                let detail = format!("{call} panicked instead of returning {kind}: {e}");
+                return Err(self.fail_with(check, detail, e));
             }
             Err(e) => format!("{call} returned the wrong error: {e:?}; expected {kind}"),
         };
@@ -227,30 +296,81 @@ under_test! {
     Policy => GuardedPolicy, "policy";
     QueryChannel => GuardedChannel, "query channel";
     Environment => GuardedEnvironment, "environment";
+    WorkloadModel => GuardedWorkload, "workload model";
 }
 
-/// A factory-driven suite, started: see [`start`].
-pub(crate) struct Started<M, T: ?Sized> {
+/// How every factory-driven suite runs: `make`'s objects come under the
+/// plugin panic guard, so a panic in a method is reported as a failure of
+/// the check that called it instead of unwinding through the suite; the
+/// options are validated and a first instance is built (a failure of
+/// either is a [`Check::Build`] failure of the factory); the checker
+/// reports under that instance's name and runs `only` check, or all.
+/// Then `suite` runs, and once it has dropped every object it built,
+/// [`Check::Destructor`] fails if any of them panicked in its destructor.
+pub(crate) fn run_suite<'m, T: UnderTest + ?Sized>(
+    make: &'m dyn Fn() -> hil_core::Result<Box<T>>,
+    opts: &CheckOptions,
+    only: Option<Check>,
+    suite: impl FnOnce(Started<'m, T>, &CheckOptions) -> SuiteResult,
+) -> SuiteResult {
+    // Destructor panics left on this thread by earlier work are not ours.
+    drop(hil_plugin::take_destructor_panics_on_this_thread());
+    let result = start(make, opts, only).and_then(|s| suite(s, opts));
+    let panics = hil_plugin::take_destructor_panics_on_this_thread();
+    let report = result?;
+    destructor_check(report, only, &panics)
+}
+
+/// [`Check::Destructor`] over the destructor panics of a run that
+/// otherwise passed: one failure for all of them, naming how many objects
+/// panicked and showing the first panic (with its location and backtrace)
+/// once.
+pub(crate) fn destructor_check(
+    mut report: ConformanceReport,
+    only: Option<Check>,
+    panics: &[HilError],
+) -> Result<ConformanceReport, ConformanceFailure> {
+    if only.is_some_and(|o| o != Check::Destructor) {
+        return Ok(report);
+    }
+    let Some(first) = panics.first() else {
+        report.passed.push(Check::Destructor);
+        return Ok(report);
+    };
+    let n = panics.len();
+    Err(ConformanceFailure {
+        subject: report.subject,
+        check: Check::Destructor,
+        detail: format!(
+            "{n} object{} the suite built panicked when dropped; the first: {first}",
+            if n == 1 { "" } else { "s" }
+        ),
+        panicked_in: Some("drop".into()),
+    })
+}
+
+/// What a suite returns.
+pub(crate) type SuiteResult = Result<ConformanceReport, ConformanceFailure>;
+
+/// A factory of guarded objects under test.
+pub(crate) type MakeGuarded<'m, T> = Box<dyn Fn() -> hil_core::Result<Box<T>> + 'm>;
+
+/// A factory-driven suite, started: see [`run_suite`].
+pub(crate) struct Started<'m, T: ?Sized> {
     /// Builds a fresh guarded instance.
-    pub make: M,
+    pub make: MakeGuarded<'m, T>,
     /// The first instance, already built.
     pub first: Box<T>,
     /// Reports under the first instance's name.
     pub checker: Checker,
 }
 
-/// How every factory-driven suite starts: `make`'s objects come under the
-/// plugin panic guard, so a panic in a method is reported as a failure of
-/// the check that called it instead of unwinding through the suite; the
-/// options are validated and a first instance is built (a failure of
-/// either is a [`Check::Build`] failure of the factory); the checker
-/// reports under that instance's name and runs `only` check, or all.
-pub(crate) fn start<'m, T: UnderTest + ?Sized>(
+fn start<'m, T: UnderTest + ?Sized>(
     make: &'m dyn Fn() -> hil_core::Result<Box<T>>,
     opts: &CheckOptions,
     only: Option<Check>,
-) -> Result<Started<impl Fn() -> hil_core::Result<Box<T>> + 'm, T>, ConformanceFailure> {
-    let make = move || make()?.guard();
+) -> Result<Started<'m, T>, ConformanceFailure> {
+    let make: MakeGuarded<'m, T> = Box::new(move || make()?.guard());
     let build_failure = |e: HilError| ConformanceFailure::of_factory(T::WHAT, &e);
     opts.validate().map_err(build_failure)?;
     let first = make().map_err(build_failure)?;
@@ -271,6 +391,7 @@ impl ConformanceFailure {
             subject: format!("<{what} factory>"),
             check: Check::Build,
             detail: e.to_string(),
+            panicked_in: hil_plugin::panicked_in(e),
         }
     }
 }
@@ -280,6 +401,17 @@ fn describe_error(e: &HilError) -> String {
     match e {
         HilError::Plugin { .. } => format!("it panicked (the plugin guard reported: {e})"),
         _ => format!("unexpected error: {e}"),
+    }
+}
+
+/// The `i`-th query kind of a suite's sequence: every response type,
+/// difficulty and distraction in turn, each of the 18 kinds once per 18.
+pub(crate) fn query_kind(i: usize) -> hil_core::QueryKind {
+    use hil_core::{Difficulty, Distraction, ResponseType};
+    hil_core::QueryKind {
+        response: ResponseType::ALL[i % 3],
+        difficulty: Difficulty::ALL[(i / 3) % 2],
+        distraction: Distraction::ALL[(i / 6) % 3],
     }
 }
 

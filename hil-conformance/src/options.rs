@@ -47,7 +47,7 @@ impl Default for CheckOptions {
     /// Six task-neutral actions (`a` to `f`: implementations must not depend
     /// on one task's action names), an 8-d context, a workload model adding
     /// 0.1 per query, 36 queries (every query kind twice), 3 attempts per
-    /// item and 40 decision steps.
+    /// item and a long trajectory of 300 steps.
     fn default() -> Self {
         Self {
             actions: ActionSpace::new(["a", "b", "c", "d", "e", "f"])
@@ -56,7 +56,7 @@ impl Default for CheckOptions {
             workload: Arc::new(CountingWorkload::new(0.1)),
             queries: 36,
             attempts: 3,
-            steps: 40,
+            steps: 300,
         }
     }
 }
@@ -92,7 +92,13 @@ impl CheckOptions {
         self
     }
 
-    /// Decision steps a policy is driven for in each lockstep comparison.
+    /// The length of the long trajectory every suite runs, beyond any
+    /// plausible buffer or warm-up, so a component that fails on its 50th
+    /// call fails the suite: the decision steps of a policy's lockstep
+    /// comparison (and of each half of its checkpoint run), the attempts an
+    /// environment executes over consecutive episodes, the queries one
+    /// query channel answers, the queries of a workload model's growing
+    /// history.
     pub fn with_steps(mut self, n: usize) -> Self {
         self.steps = n;
         self
@@ -118,7 +124,7 @@ impl CheckOptions {
     pub fn attempts(&self) -> u32 {
         self.attempts
     }
-    /// Decision steps per lockstep comparison.
+    /// The length of the long trajectory (see [`CheckOptions::with_steps`]).
     pub fn steps(&self) -> usize {
         self.steps
     }

@@ -1,10 +1,14 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::{Check, CheckOptions, Checker, ConformanceFailure, ConformanceReport, random_context};
+use serde_json::Value;
+
+use super::{
+    Check, CheckOptions, Checker, ConformanceFailure, ConformanceReport, UnderTest, random_context,
+};
 use hil_core::{
-    ActionSpace, ArmId, Choice, Context, Decision, DecisionInput, Feedback, HilError, Policy,
-    QueryHistory, Timestep, WorkloadForecast, WorkloadModel,
+    ActionSpace, ArmId, Attempt, Choice, Context, Decision, DecisionInput, Diagnostics, Feedback,
+    HilError, Policy, QueryHistory, Timestep, WorkloadForecast, WorkloadModel,
 };
 
 type Make<'a> = &'a dyn Fn() -> hil_core::Result<Box<dyn Policy>>;
@@ -13,63 +17,63 @@ type Make<'a> = &'a dyn Fn() -> hil_core::Result<Box<dyn Policy>>;
 /// options taken from the first instance's shape (its arms and dimension);
 /// see [`check_policy_with`] for the checks.
 pub fn check_policy(make: Make<'_>) -> Result<ConformanceReport, ConformanceFailure> {
-    let probe = make().map_err(|e| ConformanceFailure::of_factory("policy", &e))?;
+    // Guarded, so a panic (in the factory, the shape or the destructor) is
+    // a failure like any other; the probe's destructor is checked with the
+    // suite's objects.
+    let probe = make()
+        .and_then(|p| p.guard())
+        .map_err(|e| ConformanceFailure::of_factory("policy", &e))?;
     let (n_arms, dim) = (probe.n_arms(), probe.dim());
     let names: Vec<String> = (0..n_arms).map(|i| format!("arm{i}")).collect();
     let Ok(actions) = ActionSpace::new(names) else {
+        let subject = probe.name().to_string();
+        drop(probe);
         return Err(ConformanceFailure {
-            subject: probe.name().to_string(),
+            subject,
             check: Check::PolicyShape,
             detail: format!("n_arms = {n_arms}, dim = {dim}"),
+            panicked_in: None,
         });
     };
+    drop(probe);
     let opts = CheckOptions::default()
         .with_actions(actions)
         .with_context_dim(dim.max(1));
     check_policy_with(make, &opts)
 }
 
-/// Runs every policy property on policies built by `make` (a factory that
-/// should build for `opts.build_context()`), stopping at the first failure.
-///
-/// Properties, each on fresh instances: [`Check::PolicyShape`] (the shape
-/// is the options' action space and context dimension),
-/// [`Check::ArmInRange`], [`Check::FiniteDiagnostics`],
-/// [`Check::DiagnosticsCoverArms`], [`Check::Determinism`] (two instances
-/// seeded alike, driven in lockstep), [`Check::RejectsWrongDimension`] (a
-/// longer and a shorter context, to `decide` and `observe`, refused with
-/// [`HilError::DimensionMismatch`]), [`Check::RejectsArmOutOfRange`]
-/// ([`HilError::ArmOutOfRange`]), [`Check::RejectionHasNoEffect`] (after
-/// the refusals the policy still decides like its untouched twin) and
-/// [`Check::Checkpoint`] (skipped only when a fresh instance's `save`
-/// returns [`HilError::Unsupported`], what the trait's default `save` does).
-pub fn check_policy_with(
-    make: Make<'_>,
-    opts: &CheckOptions,
-) -> Result<ConformanceReport, ConformanceFailure> {
-    run(make, opts, None)
+entry_points! {
+    Policy,
+    /// Runs every policy property on policies built by `make` (a factory that
+    /// should build for `opts.task_context()`), stopping at the first failure.
+    ///
+    /// Properties, each on fresh instances: [`Check::PolicyShape`] (the shape
+    /// is the options' action space and context dimension),
+    /// [`Check::ArmInRange`], [`Check::FiniteDiagnostics`] (naming the field
+    /// and the step), [`Check::DiagnosticsCoverArms`] and [`Check::Determinism`]
+    /// (two instances seeded alike, driven in lockstep for `opts.steps()`
+    /// steps, 300 by default: a long trajectory, so a policy that fails on its
+    /// 50th call fails), [`Check::RejectsWrongDimension`] (a
+    /// longer and a shorter context, to `decide` and `observe`, refused with
+    /// [`HilError::DimensionMismatch`]), [`Check::RejectsArmOutOfRange`]
+    /// ([`HilError::ArmOutOfRange`]), [`Check::RejectionHasNoEffect`] (after
+    /// the refusals the policy still decides like its untouched twin),
+    /// [`Check::Checkpoint`] (skipped only when a fresh instance's `save`
+    /// returns [`HilError::Unsupported`], what the trait's default `save` does;
+    /// the state saved after `restore` must equal the state restored, and a
+    /// key that does not round-trip is named) and [`Check::Destructor`].
+    check_policy_with,
+    /// Runs one policy property alone (see [`check_policy_with`]); what
+    /// [`crate::conformance_tests!`] calls for each generated test.
+    check_policy_only,
 }
 
-/// Runs one policy property alone (see [`check_policy_with`]); what
-/// [`crate::conformance_tests!`] calls for each generated test.
-pub fn check_policy_only(
-    make: Make<'_>,
-    opts: &CheckOptions,
-    property: Check,
-) -> Result<ConformanceReport, ConformanceFailure> {
-    run(make, opts, Some(property))
-}
-
-fn run(
-    make: Make<'_>,
-    opts: &CheckOptions,
-    only: Option<Check>,
-) -> Result<ConformanceReport, ConformanceFailure> {
+fn suite(started: super::Started<'_, dyn Policy>, opts: &CheckOptions) -> super::SuiteResult {
     let super::Started {
         make,
         first,
         checker: mut c,
-    } = super::start(make, opts, only)?;
+    } = started;
     drop(first);
     let build = |c: &Checker| c.ok(Check::Build, make());
 
@@ -229,7 +233,16 @@ fn run(
         let state = c.ok(Check::Checkpoint, a.save())?;
         let mut r = build(&c)?;
         r.seed(1234); // the restored RNG state must override this
-        c.ok(Check::Checkpoint, r.restore(state))?;
+        c.ok(Check::Checkpoint, r.restore(state.clone()))?;
+        let again = c.ok(Check::Checkpoint, r.save())?;
+        if let Some((key, saved, resaved)) = first_difference(&state, &again) {
+            return Err(c.fail(
+                Check::Checkpoint,
+                format!(
+                    "the saved key `{key}` did not round-trip: saved {saved}, but the restored instance saves {resaved}; restore() does not set it from the checkpoint (or save() writes it in a form restore() reads back differently)"
+                ),
+            ));
+        }
         let mut pair = Pair {
             a: a.as_mut(),
             b: r.as_mut(),
@@ -248,6 +261,53 @@ fn run(
     Ok(c.finish())
 }
 
+/// The first field of `diag` that is not finite
+/// ([`Diagnostics::first_non_finite`], what the session loop refuses), or a
+/// negative bonus: its path (`arms[2].estimate`, `gap`, `extra.agreement`)
+/// and value.
+fn ill_formed(diag: &Diagnostics) -> Option<(String, f64)> {
+    diag.first_non_finite().or_else(|| {
+        let (i, a) = diag.arms.iter().enumerate().find(|(_, a)| a.bonus < 0.0)?;
+        Some((format!("arms[{i}].bonus"), a.bonus))
+    })
+}
+
+/// The first place where two saved states differ: its key path
+/// (`counts[1][0]`, `rng.word_pos`; `` for the whole value) and both
+/// values, as JSON.
+fn first_difference(a: &Value, b: &Value) -> Option<(String, String, String)> {
+    fn walk(path: String, a: &Value, b: &Value) -> Option<(String, String, String)> {
+        let join = |key: &str| {
+            if path.is_empty() {
+                key.to_string()
+            } else {
+                format!("{path}.{key}")
+            }
+        };
+        match (a, b) {
+            (Value::Object(x), Value::Object(y)) => {
+                let keys = x.keys().chain(y.keys().filter(|k| !x.contains_key(*k)));
+                keys.map(|k| match (x.get(k), y.get(k)) {
+                    (Some(u), Some(v)) => walk(join(k), u, v),
+                    (u, v) => Some((join(k), show(u), show(v))),
+                })
+                .find_map(|d| d)
+            }
+            (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+                .iter()
+                .zip(y)
+                .enumerate()
+                .find_map(|(i, (u, v))| walk(format!("{path}[{i}]"), u, v)),
+            _ if a == b => None,
+            _ => Some((path, a.to_string(), b.to_string())),
+        }
+    }
+    fn show(v: Option<&Value>) -> String {
+        v.map_or_else(|| "nothing".to_string(), Value::to_string)
+    }
+    walk(String::new(), a, b)
+}
+
 /// The one place the suite builds a [`DecisionInput`].
 fn decision_input<'a>(
     x: &'a Context,
@@ -263,7 +323,13 @@ fn decision_input<'a>(
 
 /// The one place the suite builds a [`Feedback`].
 fn feedback(x: &Context, arm: ArmId, reward: f64, t: Timestep, from_expert: bool) -> Feedback<'_> {
-    Feedback::new(x, arm, reward, t).from_expert(from_expert)
+    Feedback::new(Attempt {
+        context: x,
+        arm,
+        reward,
+        t,
+    })
+    .from_expert(from_expert)
 }
 
 /// Two policies fed identical inputs, with the inputs each has seen.
@@ -341,10 +407,16 @@ fn drive(
     } else {
         (s.item, s.attempt + 1)
     };
-    let d = c.ok(
-        err,
-        p.decide(&decision_input(x, t, item, attempt, model, &s.history)),
-    )?;
+    let at_t = |mut f: ConformanceFailure| {
+        f.detail = format!("at t = {t}: {}", f.detail);
+        f
+    };
+    let d = c
+        .ok(
+            err,
+            p.decide(&decision_input(x, t, item, attempt, model, &s.history)),
+        )
+        .map_err(at_t)?;
     let n = p.n_arms();
     let arm = match d.choice {
         Choice::Act { arm } => arm,
@@ -362,18 +434,15 @@ fn drive(
         return Err(c.fail(err, format!("decide returned arm {} of {n}", arm.0)));
     }
     let diag = &d.diagnostics;
-    let finite = diag.arms.iter().all(|a| {
-        a.estimate.is_finite() && a.bonus.is_finite() && a.ucb.is_finite() && a.bonus >= 0.0
-    }) && [
-        diag.gap,
-        diag.threshold,
-        diag.query_probability,
-        diag.workload_forecast,
-    ]
-    .iter()
-    .all(|v| v.is_none_or(f64::is_finite));
-    c.check(Check::FiniteDiagnostics, finite, || {
-        format!("at t = {t}: {diag:?}")
+    let bad = ill_formed(diag);
+    c.check(Check::FiniteDiagnostics, bad.is_none(), || {
+        let (field, v) = bad.clone().unwrap_or_default();
+        let what = if v.is_finite() {
+            "negative"
+        } else {
+            "not finite"
+        };
+        format!("the decision at t = {t} reports diagnostics.{field} = {v} ({what})")
     })?;
     c.check(
         Check::DiagnosticsCoverArms,
@@ -381,7 +450,8 @@ fn drive(
         || format!("{} entries for {n} arms", diag.arms.len()),
     )?;
     let queried = matches!(d.choice, Choice::Query { .. });
-    c.ok(err, p.observe(&feedback(x, arm, reward, t, queried)))?;
+    c.ok(err, p.observe(&feedback(x, arm, reward, t, queried)))
+        .map_err(at_t)?;
     if let Choice::Query { kind, .. } = d.choice {
         c.ok(err, s.history.push(t, kind))?;
     }
@@ -389,4 +459,57 @@ fn drive(
     s.item = item;
     s.attempt = attempt;
     Ok(d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hil_core::ArmDiagnostics;
+    use serde_json::json;
+
+    #[test]
+    fn ill_formed_diagnostics_are_named_by_field() {
+        let ok = Diagnostics::new().with_arms(vec![ArmDiagnostics::new(0.5, 0.1, 0.6); 2]);
+        assert_eq!(ill_formed(&ok), None);
+        let nan = ok.clone().with_arms(vec![
+            ArmDiagnostics::new(0.5, 0.1, 0.6),
+            ArmDiagnostics::new(f64::NAN, 0.1, 0.6),
+        ]);
+        assert_eq!(
+            ill_formed(&nan).map(|f| f.0).as_deref(),
+            Some("arms[1].estimate")
+        );
+        let negative = ok
+            .clone()
+            .with_arms(vec![ArmDiagnostics::new(0.5, -0.1, 0.4)]);
+        assert_eq!(ill_formed(&negative), Some(("arms[0].bonus".into(), -0.1)));
+        let gap = ok.clone().with_gap(f64::INFINITY);
+        assert_eq!(ill_formed(&gap).map(|f| f.0).as_deref(), Some("gap"));
+        let extra = ok.with_extra("agreement", f64::NAN);
+        assert_eq!(
+            ill_formed(&extra).map(|f| f.0).as_deref(),
+            Some("extra.agreement")
+        );
+    }
+
+    #[test]
+    fn the_first_difference_of_two_states_names_its_key() {
+        let a = json!({"counts": [[1.0, 2.0], [0.0, 1.0]], "rng": {"seed": 3, "pos": "12"}});
+        assert_eq!(first_difference(&a, &a), None);
+        let mut b = a.clone();
+        b["rng"]["pos"] = json!(12.0);
+        assert_eq!(
+            first_difference(&a, &b),
+            Some(("rng.pos".into(), "\"12\"".into(), "12.0".into()))
+        );
+        let mut b = a.clone();
+        b["counts"][1][0] = json!(5.0);
+        assert_eq!(first_difference(&a, &b).unwrap().0, "counts[1][0]");
+        let mut b = a.clone();
+        b.as_object_mut().unwrap().remove("counts");
+        assert_eq!(
+            first_difference(&a, &b).map(|d| (d.0, d.2)),
+            Some(("counts".into(), "nothing".into()))
+        );
+    }
 }

@@ -3,7 +3,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
 use super::strategies::query_history;
 use super::{Check, CheckOptions, Checker, ConformanceFailure, ConformanceReport};
-use hil_core::{QueryKind, WorkloadInput, WorkloadModel};
+use hil_core::{QueryHistory, QueryKind, WorkloadInput, WorkloadModel};
 
 /// Runs the workload-model conformance suite; see
 /// [`check_workload_model_with`] for the checks.
@@ -20,13 +20,18 @@ pub fn check_workload_model(
 /// value), [`Check::FinitePrediction`], [`Check::DeterministicPrediction`]
 /// (repeated calls agree to the bit) and [`Check::Counterfactual`]
 /// (`predict_if_queried` equals `predict` on the history with the query
-/// appended). The options are not used yet; they are taken for symmetry
-/// with the other suites.
+/// appended); then, over a long trajectory (a history growing by one query
+/// per step to `opts.steps()` queries, 300 by default, beyond any plausible
+/// buffer), that `predict` succeeds and is finite at every step.
+///
+/// The model is only borrowed, so [`Check::Destructor`] is not run: the
+/// factory forms ([`check_workload_model_built_with`]) build, check and
+/// drop their own instance.
 pub fn check_workload_model_with(
     model: &dyn WorkloadModel,
     opts: &CheckOptions,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    run(model, opts, None)
+    run(model, opts, Checker::new(model.name(), None))
 }
 
 /// Runs one workload-model property alone (see [`check_workload_model_with`]).
@@ -35,20 +40,38 @@ pub fn check_workload_model_only(
     opts: &CheckOptions,
     property: Check,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    run(model, opts, Some(property))
+    run(model, opts, Checker::new(model.name(), Some(property)))
+}
+
+entry_points! {
+    WorkloadModel,
+    /// Runs every workload-model property (see [`check_workload_model_with`])
+    /// on a model built by `make`, under the plugin panic guard, and, once the
+    /// model is dropped, [`Check::Destructor`]. What `hil plugins check` and
+    /// [`crate::conformance_tests!`] run.
+    check_workload_model_built_with,
+    /// Runs one workload-model property alone on a model built by `make`
+    /// (see [`check_workload_model_built_with`]).
+    check_workload_model_built_only,
+}
+
+fn suite(
+    started: super::Started<'_, dyn WorkloadModel>,
+    opts: &CheckOptions,
+) -> super::SuiteResult {
+    run(started.first.as_ref(), opts, started.checker)
 }
 
 const WL0S: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
 
 fn run(
     model: &dyn WorkloadModel,
-    _opts: &CheckOptions,
-    only: Option<Check>,
+    opts: &CheckOptions,
+    mut c: Checker,
 ) -> Result<ConformanceReport, ConformanceFailure> {
     let caught = Caught(model);
     let model: &dyn WorkloadModel = &caught;
-    let mut c = Checker::new(model.name(), only);
-    let empty = hil_core::QueryHistory::new();
+    let empty = QueryHistory::new();
     if c.wants(Check::EmptyHistory) {
         for wl0 in WL0S {
             let p = c.ok(
@@ -136,7 +159,37 @@ fn run(
             }
         }
     }
+    long_history(&mut c, model, opts.steps())?;
     Ok(c.finish())
+}
+
+/// The long trajectory: one query per step, every kind in turn, for
+/// `steps` steps, predicting after each.
+fn long_history(
+    c: &mut Checker,
+    model: &dyn WorkloadModel,
+    steps: usize,
+) -> Result<(), ConformanceFailure> {
+    let mut history = QueryHistory::new();
+    for step in 1..=steps as u64 {
+        c.ok(
+            Check::Predicts,
+            history.push(step, super::query_kind(step as usize)),
+        )?;
+        let p = c
+            .ok(
+                Check::Predicts,
+                model.predict(&WorkloadInput::new(0.5, &history, step)),
+            )
+            .map_err(|mut f| {
+                f.detail = format!("at query {step} of a growing history: {}", f.detail);
+                f
+            })?;
+        c.check(Check::FinitePrediction, p.is_finite(), || {
+            format!("WL_0 = 0.5, after {step} queries, one per step: {p}")
+        })?;
+    }
+    Ok(())
 }
 
 /// A model whose panics become errors, as the plugin guard reports them, so
@@ -146,16 +199,7 @@ struct Caught<'a>(&'a dyn WorkloadModel);
 
 impl Caught<'_> {
     fn run<T>(&self, method: &str, f: impl FnOnce() -> hil_core::Result<T>) -> hil_core::Result<T> {
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|p| {
-            Err(hil_core::HilError::Plugin {
-                path: super::under_test(),
-                why: format!(
-                    "`{}` panicked in {method}: {}",
-                    self.0.name(),
-                    hil_plugin::panic_message(&*p)
-                ),
-            })
-        })
+        hil_plugin::call_guarded(&super::under_test(), self.0.name(), method, f)
     }
 }
 

@@ -143,27 +143,38 @@ impl Diagnostics {
         self
     }
 
+    // The builders of optional fields take `impl Into<Option<f64>>`: a
+    // value sets the field, `None` clears it, and a caller holding an
+    // `Option` passes it as it is (one convention for every builder).
+
     /// With the query gap G.
-    pub fn with_gap(mut self, gap: f64) -> Self {
-        self.gap = Some(gap);
+    pub fn with_gap(mut self, gap: impl Into<Option<f64>>) -> Self {
+        self.gap = gap.into();
         self
     }
 
     /// With the threshold the gap was compared against.
-    pub fn with_threshold(mut self, threshold: f64) -> Self {
-        self.threshold = Some(threshold);
+    pub fn with_threshold(mut self, threshold: impl Into<Option<f64>>) -> Self {
+        self.threshold = threshold.into();
         self
     }
 
     /// With the probability of querying.
-    pub fn with_query_probability(mut self, p: f64) -> Self {
-        self.query_probability = Some(p);
+    pub fn with_query_probability(mut self, p: impl Into<Option<f64>>) -> Self {
+        self.query_probability = p.into();
         self
     }
 
     /// With the workload forecast used (none if `None`).
-    pub fn with_workload_forecast(mut self, forecast: Option<f64>) -> Self {
-        self.workload_forecast = forecast;
+    ///
+    /// ```
+    /// use hil_core::Diagnostics;
+    /// let d = Diagnostics::new().with_gap(0.2).with_workload_forecast(Some(0.4));
+    /// assert_eq!((d.gap, d.workload_forecast), (Some(0.2), Some(0.4)));
+    /// assert_eq!(d.with_gap(None).gap, None);
+    /// ```
+    pub fn with_workload_forecast(mut self, forecast: impl Into<Option<f64>>) -> Self {
+        self.workload_forecast = forecast.into();
         self
     }
 
@@ -171,6 +182,42 @@ impl Diagnostics {
     pub fn with_extra(mut self, name: impl Into<String>, value: f64) -> Self {
         self.extra.insert(name, value);
         self
+    }
+
+    /// The first field that is not a finite number, by its path
+    /// (`arms[1].ucb`, `gap`, `extra.agreement`), with its value. The one
+    /// definition the session loop and the conformance suite both check;
+    /// it allocates only to name a bad field.
+    ///
+    /// ```
+    /// use hil_core::{ArmDiagnostics, Diagnostics};
+    /// let d = Diagnostics::new().with_arms(vec![ArmDiagnostics::new(0.5, 0.1, 0.6); 2]);
+    /// assert_eq!(d.first_non_finite(), None);
+    /// let d = d.with_gap(f64::NAN);
+    /// assert_eq!(d.first_non_finite().map(|(field, _)| field).as_deref(), Some("gap"));
+    /// ```
+    pub fn first_non_finite(&self) -> Option<(String, f64)> {
+        for (i, a) in self.arms.iter().enumerate() {
+            for (name, v) in [("estimate", a.estimate), ("bonus", a.bonus), ("ucb", a.ucb)] {
+                if !v.is_finite() {
+                    return Some((format!("arms[{i}].{name}"), v));
+                }
+            }
+        }
+        for (name, v) in [
+            ("gap", self.gap),
+            ("threshold", self.threshold),
+            ("query_probability", self.query_probability),
+            ("workload_forecast", self.workload_forecast),
+        ] {
+            if let Some(v) = v.filter(|v| !v.is_finite()) {
+                return Some((name.to_string(), v));
+            }
+        }
+        self.extra
+            .iter()
+            .find(|(_, v)| !v.is_finite())
+            .map(|(name, v)| (format!("extra.{name}"), v))
     }
 }
 
@@ -238,9 +285,10 @@ impl Outcome {
         }
     }
 
-    /// With the probability that the action succeeds in this context.
-    pub fn with_success_probability(mut self, p: f64) -> Self {
-        self.success_probability = Some(p);
+    /// With the probability that the action succeeds in this context
+    /// (`None`: not known).
+    pub fn with_success_probability(mut self, p: impl Into<Option<f64>>) -> Self {
+        self.success_probability = p.into();
         self
     }
 

@@ -54,7 +54,7 @@ pub use environment::{CallOrder, Environment};
 pub use error::{BoxError, ConfigError, HilError, Result};
 pub use event::{PendingStep, StepDecision, StepEvent};
 pub use metrics::EpisodeMetrics;
-pub use policy::{DecisionInput, Feedback, Policy};
+pub use policy::{Attempt, DecisionInput, Feedback, Policy};
 pub use query::{
     Answer, BoundingBox, Difficulty, Distraction, Query, QueryKind, Response, ResponseType,
 };

@@ -59,13 +59,28 @@ impl<'a> DecisionInput<'a> {
     }
 }
 
+/// The facts of one attempt, by name: what [`Feedback::new`] takes, so the
+/// call site says which number is the reward and which the timestep.
+#[derive(Clone, Copy, Debug)]
+pub struct Attempt<'a> {
+    /// The context the attempt was made in.
+    pub context: &'a Context,
+    /// The arm that was executed (the expert's after a query).
+    pub arm: ArmId,
+    /// The observed reward (1 on success, 0 otherwise).
+    pub reward: f64,
+    /// Session timestep of the attempt.
+    pub t: Timestep,
+}
+
 /// What a policy learns from after an attempt.
 ///
 /// ```
-/// use hil_core::{ArmId, Context, Feedback};
+/// use hil_core::{ArmId, Attempt, Context, Feedback};
 /// let x = Context::new(vec![0.5; 3]).unwrap();
-/// let f = Feedback::new(&x, ArmId(2), 1.0, 4).from_expert(true);
-/// assert!(f.from_expert && f.reward == 1.0);
+/// let f = Feedback::new(Attempt { context: &x, arm: ArmId(2), reward: 1.0, t: 4 })
+///     .from_expert(true);
+/// assert!(f.from_expert && f.reward == 1.0 && f.t == 4);
 /// ```
 #[derive(Clone, Copy, Debug)]
 #[non_exhaustive]
@@ -83,9 +98,15 @@ pub struct Feedback<'a> {
 }
 
 impl<'a> Feedback<'a> {
-    /// The reward `reward` seen after executing `arm` in `context` at `t`,
-    /// chosen by the policy (see [`Feedback::from_expert`]).
-    pub fn new(context: &'a Context, arm: ArmId, reward: f64, t: Timestep) -> Self {
+    /// The feedback of `attempt`, whose arm the policy chose (see
+    /// [`Feedback::from_expert`]).
+    pub fn new(attempt: Attempt<'a>) -> Self {
+        let Attempt {
+            context,
+            arm,
+            reward,
+            t,
+        } = attempt;
         Self {
             context,
             arm,

@@ -206,9 +206,10 @@ impl Query {
         }
     }
 
-    /// With the best action, known to a simulated environment.
-    pub fn with_oracle_best(mut self, arm: ArmId) -> Self {
-        self.oracle_best = Some(arm);
+    /// With the best action, known to a simulated environment (`None`: not
+    /// known).
+    pub fn with_oracle_best(mut self, arm: impl Into<Option<ArmId>>) -> Self {
+        self.oracle_best = arm.into();
         self
     }
 }
@@ -304,9 +305,9 @@ impl Response {
         Self::new(answer, None, None)
     }
 
-    /// With the seconds the person took to answer.
-    pub fn with_response_time(mut self, seconds: f64) -> Self {
-        self.response_time_s = Some(seconds);
+    /// With the seconds the person took to answer (`None`: not measured).
+    pub fn with_response_time(mut self, seconds: impl Into<Option<f64>>) -> Self {
+        self.response_time_s = seconds.into();
         self
     }
 }

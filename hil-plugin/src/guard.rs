@@ -20,11 +20,21 @@
 //! over through [`super::PluginRegistrar::drop_panic_sink`]) and collected
 //! there until the host asks for it with [`take_destructor_panics`]: `hil`
 //! reports it as an error after the run, instead of carrying on silently.
+//!
+//! A caught panic is not printed: while a guard runs a call, the panic hook
+//! of the standard library the call runs in (the plugin's own copy) only
+//! records where the panic happened, and the backtrace when
+//! `RUST_BACKTRACE` asks for one, and the error carries both. So a report
+//! says it once, in its place, instead of the default hook printing it to
+//! stderr at every panic. Panics outside a guard go to the previous hook.
 
 use std::any::Any;
+use std::backtrace::{Backtrace, BacktraceStatus};
+use std::cell::{Cell, RefCell};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Mutex, Once, OnceLock};
+use std::thread::ThreadId;
 
 use serde_json::Value;
 
@@ -45,29 +55,137 @@ pub fn panic_message(payload: &(dyn Any + Send)) -> String {
     }
 }
 
-fn panicked(lib: &Path, name: &str, method: &str, payload: &(dyn Any + Send)) -> HilError {
-    HilError::Plugin {
-        path: lib.to_path_buf(),
-        why: format!("`{name}` panicked in {method}: {}", panic_message(payload)),
+/// A panic caught by a guard: its message, and where it happened as the
+/// panic hook saw it.
+pub(crate) struct Panic {
+    message: String,
+    /// `file:line:column`, when the hook saw the panic.
+    location: Option<String>,
+    /// Captured when `RUST_BACKTRACE` (or `RUST_LIB_BACKTRACE`) asks for it.
+    backtrace: Option<Backtrace>,
+}
+
+impl Panic {
+    /// The message, then where it happened (and the backtrace, if any).
+    pub(crate) fn describe(&self) -> String {
+        let mut s = self.message.clone();
+        if let Some(at) = &self.location {
+            s.push_str(&format!(" (at {at})"));
+        }
+        if let Some(bt) = &self.backtrace {
+            s.push_str(&format!("\nbacktrace:\n{bt}"));
+        }
+        s
     }
 }
+
+/// What the hook saw of the last panic on this thread inside a guard.
+struct Seen {
+    location: Option<String>,
+    backtrace: Option<Backtrace>,
+}
+
+thread_local! {
+    /// How many guarded calls this thread is inside.
+    static GUARDED: Cell<usize> = const { Cell::new(0) };
+    /// The hook's record of the panic being unwound.
+    static SEEN: RefCell<Option<Seen>> = const { RefCell::new(None) };
+}
+
+/// Installs (once per copy of the standard library) the hook that records
+/// a guarded panic instead of printing it, and leaves every other panic to
+/// the hook that was there before.
+fn install_hook() {
+    static HOOK: Once = Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if GUARDED.try_with(Cell::get).unwrap_or(0) == 0 {
+                return previous(info);
+            }
+            let backtrace = Backtrace::capture();
+            let seen = Seen {
+                location: info.location().map(ToString::to_string),
+                backtrace: (backtrace.status() == BacktraceStatus::Captured).then_some(backtrace),
+            };
+            let _ = SEEN.try_with(|s| *s.borrow_mut() = Some(seen));
+        }));
+    });
+}
+
+/// Runs `f`, catching a panic (recorded by the hook, not printed). The one
+/// `catch_unwind` of the guards.
+pub(crate) fn catch<T>(f: impl FnOnce() -> T) -> std::result::Result<T, Panic> {
+    install_hook();
+    GUARDED.with(|g| g.set(g.get() + 1));
+    let r = catch_unwind(AssertUnwindSafe(f));
+    GUARDED.with(|g| g.set(g.get() - 1));
+    r.map_err(|payload| {
+        let seen = SEEN.with(|s| s.borrow_mut().take());
+        Panic {
+            message: panic_message(&*payload),
+            location: seen.as_ref().and_then(|s| s.location.clone()),
+            backtrace: seen.and_then(|s| s.backtrace),
+        }
+    })
+}
+
+fn panicked(lib: &Path, name: &str, method: &str, panic: &Panic) -> HilError {
+    HilError::Plugin {
+        path: lib.to_path_buf(),
+        why: format!("`{name}{PANICKED}{method}: {}", panic.describe()),
+    }
+}
+
+/// The method a guarded panic happened in, read from the error a guard
+/// made of it ([`HilError::Plugin`] saying `panicked in METHOD: ...`, or,
+/// for a later call on the poisoned object, `panicked earlier, in
+/// METHOD: ...`); `None` for any other error.
+///
+/// ```
+/// use hil_core::HilError;
+/// let e = hil_plugin::call_guarded(std::path::Path::new("lib.so"), "p", "seed", || -> hil_core::Result<()> {
+///     panic!("no seed")
+/// }).unwrap_err();
+/// assert_eq!(hil_plugin::panicked_in(&e).as_deref(), Some("seed"));
+/// assert_eq!(hil_plugin::panicked_in(&HilError::state("p", "late")), None);
+/// ```
+pub fn panicked_in(e: &HilError) -> Option<String> {
+    let HilError::Plugin { why, .. } = e else {
+        return None;
+    };
+    let (_, rest) = why
+        .split_once(POISONED)
+        .or_else(|| why.split_once(PANICKED))?;
+    rest.split_once(':').map(|(method, _)| method.to_string())
+}
+
+/// What a guard's error says before the method that panicked (read back
+/// by [`panicked_in`]).
+const PANICKED: &str = "` panicked in ";
+/// The same, on a call to an object poisoned by an earlier panic.
+const POISONED: &str = "it panicked earlier, in ";
 
 /// Where a panic in a plugin object's destructor is reported: a plain
 /// function of the host's, so that the error lands in the host's copy of
 /// hil-core whichever copy (the plugin's) ran the destructor.
 pub type DropPanicSink = fn(HilError);
 
-/// The destructor panics reported so far, in the copy of hil-core that owns
-/// this static (the host's, through [`report_drop_panic`]).
-static DROP_PANICS: Mutex<Vec<HilError>> = Mutex::new(Vec::new());
+/// The destructor panics reported so far, with the thread that dropped the
+/// object, in the copy of hil-plugin that owns this static (the host's,
+/// through [`report_drop_panic`]).
+static DROP_PANICS: Mutex<Vec<(ThreadId, HilError)>> = Mutex::new(Vec::new());
+
+fn drop_panics() -> std::sync::MutexGuard<'static, Vec<(ThreadId, HilError)>> {
+    DROP_PANICS
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
 
 /// The host's [`DropPanicSink`]: remembers the error for
 /// [`take_destructor_panics`].
 pub fn report_drop_panic(error: HilError) {
-    DROP_PANICS
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner())
-        .push(error);
+    drop_panics().push((std::thread::current().id(), error));
 }
 
 /// Takes the errors of every plugin destructor that panicked since the last
@@ -78,21 +196,36 @@ pub fn report_drop_panic(error: HilError) {
 /// assert!(hil_plugin::take_destructor_panics().is_empty());
 /// ```
 pub fn take_destructor_panics() -> Vec<HilError> {
-    std::mem::take(
-        &mut *DROP_PANICS
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner()),
-    )
+    std::mem::take(&mut *drop_panics())
+        .into_iter()
+        .map(|(_, e)| e)
+        .collect()
 }
 
-/// Runs `f`, turning a panic into a [`HilError::Plugin`].
-pub(crate) fn call<T>(
-    lib: &Path,
-    name: &str,
-    method: &str,
-    f: impl FnOnce() -> Result<T>,
-) -> Result<T> {
-    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| Err(panicked(lib, name, method, &*p)))
+/// Takes the destructor panics of objects dropped on this thread since the
+/// last call, leaving other threads' for them: what a conformance suite,
+/// which builds and drops its objects on the calling thread, reads while
+/// other suites run on other threads.
+///
+/// ```
+/// assert!(hil_plugin::take_destructor_panics_on_this_thread().is_empty());
+/// ```
+pub fn take_destructor_panics_on_this_thread() -> Vec<HilError> {
+    let here = std::thread::current().id();
+    let mut all = drop_panics();
+    let (mine, others) = std::mem::take(&mut *all)
+        .into_iter()
+        .partition(|(id, _)| *id == here);
+    *all = others;
+    mine.into_iter().map(|(_, e)| e).collect()
+}
+
+/// Runs `f` for the object `name` of library `lib`, turning a panic in
+/// `method` into a [`HilError::Plugin`] that carries the panic's message,
+/// location (and backtrace, when `RUST_BACKTRACE` asks for one) instead of
+/// printing them.
+pub fn call<T>(lib: &Path, name: &str, method: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+    catch(f).unwrap_or_else(|p| Err(panicked(lib, name, method, &p)))
 }
 
 /// Where an object came from and whether it has panicked.
@@ -119,8 +252,8 @@ impl Guard {
     /// Drops a plugin object under the guard: a panicking destructor is
     /// reported to the sink as this object's panic in `drop`.
     fn drop_guarded<T>(&self, inner: Option<T>) {
-        if let Err(p) = catch_unwind(AssertUnwindSafe(move || drop(inner))) {
-            (self.on_drop_panic)(panicked(&self.library, &self.name, "drop", &*p));
+        if let Err(p) = catch(move || drop(inner)) {
+            (self.on_drop_panic)(panicked(&self.library, &self.name, "drop", &p));
         }
     }
 
@@ -129,25 +262,29 @@ impl Guard {
             None => Ok(()),
             Some(first) => Err(HilError::Plugin {
                 path: self.library.clone(),
-                why: format!(
-                    "`{}` is unusable: it panicked earlier, in {first}",
-                    self.name
-                ),
+                why: format!("`{}` is unusable: {POISONED}{first}", self.name),
             }),
         }
     }
 
-    fn poison(&self, method: &str, payload: &(dyn Any + Send)) -> HilError {
+    /// Poisons the object; the later errors name the method, message and
+    /// location (the backtrace is in this panic's own error only).
+    fn poison(&self, method: &str, panic: &Panic) -> HilError {
+        let at = panic
+            .location
+            .as_ref()
+            .map(|l| format!(" (at {l})"))
+            .unwrap_or_default();
         let _ = self
             .poisoned
-            .set(format!("{method}: {}", panic_message(payload)));
-        panicked(&self.library, &self.name, method, payload)
+            .set(format!("{method}: {}{at}", panic.message));
+        panicked(&self.library, &self.name, method, panic)
     }
 
     /// A fallible call.
     fn run<T>(&self, method: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
         self.check()?;
-        catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| Err(self.poison(method, &*p)))
+        catch(f).unwrap_or_else(|p| Err(self.poison(method, &p)))
     }
 
     /// An infallible call: a panic poisons and yields `fallback`.
@@ -155,8 +292,8 @@ impl Guard {
         if self.check().is_err() {
             return fallback;
         }
-        catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| {
-            self.poison(method, &*p);
+        catch(f).unwrap_or_else(|p| {
+            self.poison(method, &p);
             fallback
         })
     }

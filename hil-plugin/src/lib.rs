@@ -18,8 +18,12 @@
 //!    the host's;
 //! 2. a `register` function that adds named factories to a host-owned
 //!    registrar ([`Registrar`]), for any of the four traits. Factories take
-//!    their parameters as a TOML or JSON text ([`Params`]) plus the
-//!    experiment's [`BuildContext`](hil_config::BuildContext).
+//!    their parameters as a TOML or JSON text ([`Params`]) plus a context:
+//!    a [`TaskContext`](hil_config::TaskContext) (the built environment's
+//!    action space, context dimension and pretraining data, with the
+//!    build context) for policies and query channels, a
+//!    [`BuildContext`](hil_config::BuildContext) (base directory, seed,
+//!    build memo) for environments and workload models.
 //!
 //! Every factory and every method of every object a plugin returns runs
 //! under a panic guard compiled into the plugin ([`GuardedPolicy`] and
@@ -77,7 +81,8 @@ pub use builtin::builtin_types;
 pub use component::{KindOf, PluginComponent, component, optional_component};
 pub use guard::{
     DropPanicSink, Guarded, GuardedChannel, GuardedEnvironment, GuardedPolicy, GuardedWorkload,
-    report_drop_panic, take_destructor_panics,
+    call as call_guarded, panicked_in, report_drop_panic, take_destructor_panics,
+    take_destructor_panics_on_this_thread,
 };
 pub use registrar::{
     ComponentKind, EnvironmentFactory, Factory, ParamFormat, Params, PluginRegistrar,

@@ -351,6 +351,5 @@ pub fn run_register(
     register: impl FnOnce(&mut Registrar<'_>),
 ) -> std::result::Result<(), String> {
     let mut r = Registrar::new(host);
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| register(&mut r)))
-        .map_err(|p| guard::panic_message(p.as_ref()))
+    guard::catch(|| register(&mut r)).map_err(|p| p.describe())
 }

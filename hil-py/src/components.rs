@@ -12,9 +12,9 @@ use std::time::{Duration, Instant};
 use hil_config::{BuildContext, TaskContext};
 use hil_config::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
 use hil_core::{
-    ActionSpace, ArmId, Choice, Context, Decision, DecisionInput, Environment, Feedback, HilError,
-    Item, LabelledObservation, Outcome, Policy, Query, QueryChannel, QueryHistory, QueryKind,
-    Response, Result, Timestep, WorkloadForecast, WorkloadInput, WorkloadModel,
+    ActionSpace, ArmId, Attempt, Choice, Context, Decision, DecisionInput, Environment, Feedback,
+    HilError, Item, LabelledObservation, Outcome, Policy, Query, QueryChannel, QueryHistory,
+    QueryKind, Response, Result, Timestep, WorkloadForecast, WorkloadInput, WorkloadModel,
 };
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -429,7 +429,13 @@ impl PyPolicyHandle {
         from_expert: bool,
     ) -> PyResult<()> {
         let x = self.context(context)?;
-        let feedback = Feedback::new(&x, ArmId(arm), reward, t).from_expert(from_expert);
+        let attempt = Attempt {
+            context: &x,
+            arm: ArmId(arm),
+            reward,
+            t,
+        };
+        let feedback = Feedback::new(attempt).from_expert(from_expert);
         let light = self.dim < DETACH_MIN_DIM;
         self.with_state(py, light, |s| s.observe(&feedback))
             .py_err()

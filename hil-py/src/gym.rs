@@ -18,9 +18,9 @@ use hil_config::{
     EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig, check_session_limits,
 };
 use hil_core::{
-    ArmId, Choice, Context, Decision, DecisionInput, Environment, Episode, EpisodeReport, Feedback,
-    HilError, Policy, QueryChannel, QueryKind, Session, SessionSettings, StepEvent, Timestep,
-    WorkloadModel,
+    ArmId, Attempt, Choice, Context, Decision, DecisionInput, Environment, Episode, EpisodeReport,
+    Feedback, HilError, Policy, QueryChannel, QueryKind, Session, SessionSettings, StepEvent,
+    Timestep, WorkloadModel,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
@@ -412,8 +412,13 @@ impl GymCore {
             let mut state = policy.state();
             for (e, expert) in executed.iter().zip(from_expert(executed)) {
                 state.observe(
-                    &Feedback::new(&e.step.context, e.step.arm, e.outcome.reward(), e.step.t)
-                        .from_expert(expert),
+                    &Feedback::new(Attempt {
+                        context: &e.step.context,
+                        arm: e.step.arm,
+                        reward: e.outcome.reward(),
+                        t: e.step.t,
+                    })
+                    .from_expert(expert),
                 )?;
             }
             Ok(())

@@ -43,7 +43,7 @@ fn failure(py: Python<'_>, f: ConformanceFailure) -> PyErr {
     let _ = v.setattr("subject", &f.subject);
     let _ = v.setattr("check", f.check.name());
     let _ = v.setattr("detail", &f.detail);
-    let _ = v.setattr("hint", f.check.hint());
+    let _ = v.setattr("hint", f.hint());
     err
 }
 

@@ -378,12 +378,12 @@ mod tests {
         let x = hil_core::Context::new(vec![1.0]).unwrap();
         let history = hil_core::QueryHistory::new();
         for t in 1..=200 {
-            let fb = Feedback::new(
-                &x,
-                ArmId((t % 2) as usize),
-                if t % 2 == 1 { 1.0 } else { 0.0 },
+            let fb = Feedback::new(hil_core::Attempt {
+                context: &x,
+                arm: ArmId((t % 2) as usize),
+                reward: if t % 2 == 1 { 1.0 } else { 0.0 },
                 t,
-            );
+            });
             p.observe(&fb).unwrap();
         }
         let input = DecisionInput::new(&x, 201, hil_core::WorkloadForecast::none(&history));

@@ -267,7 +267,13 @@ fn bench_policy(a: &PolicyBench) -> Result<()> {
         };
         let reward = f64::from(rng.unit() < p_success(&x, arm.0));
         let mid2 = Instant::now();
-        policy.observe(&Feedback::new(&x, arm, reward, t).from_expert(expert))?;
+        let attempt = hil_core::Attempt {
+            context: &x,
+            arm,
+            reward,
+            t,
+        };
+        policy.observe(&Feedback::new(attempt).from_expert(expert))?;
         let end = Instant::now();
         if let Choice::Query { kind, .. } = d.choice {
             history.push(t, kind)?;

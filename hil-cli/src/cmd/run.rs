@@ -49,20 +49,8 @@ enum Start {
 pub fn run(args: RunArgs) -> hil_core::Result<()> {
     let result = run_session(&args).and_then(|s| print_summary(&s, args.json, args.quiet));
     // Every component has been dropped by now: a plugin object whose
-    // destructor panicked is reported (PLUGINS.md), not passed over. The
-    // first error is returned (and printed by `main`); any others are
-    // printed here.
-    let mut errors = result
-        .err()
-        .into_iter()
-        .chain(hil_plugin::take_destructor_panics());
-    let Some(first) = errors.next() else {
-        return Ok(());
-    };
-    for e in errors {
-        note!("error: {e}");
-    }
-    Err(first)
+    // destructor panicked is reported (PLUGINS.md), not passed over.
+    super::plugins::with_destructor_panics(result)
 }
 
 /// Runs (or resumes) the session `args` describe; every component is

@@ -12,8 +12,8 @@ use hil_conformance::broken::{
 use hil_conformance::{
     Check, CheckOptions, ConformanceFailure, ConformanceReport, Subject, assert_conforms,
     check_environment_only, check_environment_with, check_policy_only, check_policy_with,
-    check_query_channel_only, check_query_channel_with, check_workload_model_only,
-    check_workload_model_with,
+    check_query_channel_only, check_query_channel_with, check_workload_model_built_only,
+    check_workload_model_built_with, check_workload_model_with,
 };
 use hil_core::HilError;
 
@@ -49,10 +49,10 @@ fn environment_runs(d: Option<EnvironmentDefect>, only: Option<Check>) -> Run {
 
 fn workload_runs(d: Option<WorkloadDefect>, only: Option<Check>) -> Run {
     let opts = options();
-    let m = broken::workload_model(d).unwrap();
+    let make = || broken::workload_model(d);
     match only {
-        None => check_workload_model_with(m.as_ref(), &opts),
-        Some(p) => check_workload_model_only(m.as_ref(), &opts, p),
+        None => check_workload_model_built_with(&make, &opts),
+        Some(p) => check_workload_model_built_only(&make, &opts, p),
     }
 }
 
@@ -174,6 +174,71 @@ fn a_guarded_panic_is_a_failure_never_a_refusal() {
     // A panicking save is a checkpoint failure, not "skipped".
     let e = policy_runs(Some(PolicyDefect::PanicsInSave), None).unwrap_err();
     assert_eq!(e.check, Check::Checkpoint);
+}
+
+#[test]
+fn a_component_failing_on_its_50th_call_fails_only_a_long_trajectory() {
+    // With the old 40-step trajectory each passes; the default (300) fails it.
+    let short = options().with_steps(40);
+    let p = || broken::policy(Some(PolicyDefect::FailsOnCall50), &short);
+    check_policy_with(&p, &short).unwrap();
+    let e = policy_runs(Some(PolicyDefect::FailsOnCall50), None).unwrap_err();
+    assert_eq!(e.check, Check::PolicyDecides);
+
+    let env = || broken::environment(Some(EnvironmentDefect::FailsOnCall50));
+    check_environment_with(&env, &short).unwrap();
+    let ch = || broken::query_channel(Some(ChannelDefect::FailsOnCall50));
+    check_query_channel_with(&ch, &short).unwrap();
+    let m = broken::workload_model(Some(WorkloadDefect::FailsAfter50Queries)).unwrap();
+    check_workload_model_with(m.as_ref(), &short).unwrap();
+    let e = check_workload_model_with(m.as_ref(), &options()).unwrap_err();
+    assert_eq!(e.check, Check::Predicts);
+}
+
+#[test]
+fn a_panic_gets_the_hint_of_the_method_that_panicked() {
+    // seed cannot fail: its panic poisons the policy, and the hint is about
+    // seed, not about validating decide's input.
+    let e = policy_runs(Some(PolicyDefect::PanicsInSeed), None).unwrap_err();
+    assert_eq!(e.check, Check::PolicyDecides);
+    assert_eq!(e.panicked_in.as_deref(), Some("seed"));
+    assert_ne!(e.hint(), Check::PolicyDecides.hint());
+    // A Drop panicking inside restore: not "save() misses part of the state".
+    let e = policy_runs(Some(PolicyDefect::DropPanicsInRestore), None).unwrap_err();
+    assert_eq!(e.check, Check::Checkpoint);
+    assert_eq!(e.panicked_in.as_deref(), Some("restore"));
+    assert_ne!(e.hint(), Check::Checkpoint.hint());
+    // A checkpoint that merely forgets state keeps the checkpoint hint.
+    let e = policy_runs(Some(PolicyDefect::CheckpointForgetsRng), None).unwrap_err();
+    assert_eq!(
+        (e.panicked_in.clone(), e.hint()),
+        (None, Check::Checkpoint.hint().to_string())
+    );
+}
+
+#[test]
+fn destructor_panics_fail_once_per_report_in_every_suite() {
+    let failures = [
+        policy_runs(Some(PolicyDefect::PanicsInDrop), None),
+        environment_runs(Some(EnvironmentDefect::PanicsInDrop), None),
+        workload_runs(Some(WorkloadDefect::PanicsInDrop), None),
+        channel_runs(Some(ChannelDefect::PanicsInDrop), None),
+    ];
+    for r in failures {
+        let e = r.unwrap_err();
+        assert_eq!(
+            (e.check, e.panicked_in.as_deref()),
+            (Check::Destructor, Some("drop"))
+        );
+    }
+    // Nothing is left over for the next suite on this thread.
+    assert!(hil_plugin::take_destructor_panics_on_this_thread().is_empty());
+    // The borrowed form cannot drop the model: it does not claim the check.
+    let m = broken::workload_model(Some(WorkloadDefect::PanicsInDrop)).unwrap();
+    let report = check_workload_model_with(m.as_ref(), &options()).unwrap();
+    assert!(!report.passed.contains(&Check::Destructor));
+    drop(m);
+    assert_eq!(hil_plugin::take_destructor_panics_on_this_thread().len(), 1);
 }
 
 #[test]

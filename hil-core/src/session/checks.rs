@@ -18,33 +18,13 @@ use crate::workload::{WorkloadInput, WorkloadModel};
 /// Every diagnostic of a policy's decision must be finite. Runs at every
 /// step, so it allocates only to name a bad field.
 pub(crate) fn diagnostics(policy: &str, d: &Diagnostics) -> Result<()> {
-    let bad = |field: String, v: f64| {
-        Err(HilError::invalid_input(
+    match d.first_non_finite() {
+        Some((field, v)) => Err(HilError::invalid_input(
             format!("`diagnostics.{field}` of policy `{policy}`"),
             format!("{v} is not a finite number"),
-        ))
-    };
-    for (i, a) in d.arms.iter().enumerate() {
-        for (name, v) in [("estimate", a.estimate), ("bonus", a.bonus), ("ucb", a.ucb)] {
-            if !v.is_finite() {
-                return bad(format!("arms[{i}].{name}"), v);
-            }
-        }
+        )),
+        None => Ok(()),
     }
-    for (name, v) in [
-        ("gap", d.gap),
-        ("threshold", d.threshold),
-        ("query_probability", d.query_probability),
-        ("workload_forecast", d.workload_forecast),
-    ] {
-        if let Some(v) = v.filter(|v| !v.is_finite()) {
-            return bad(name.to_string(), v);
-        }
-    }
-    if let Some((name, v)) = d.extra.iter().find(|(_, v)| !v.is_finite()) {
-        return bad(format!("extra.{name}"), v);
-    }
-    Ok(())
 }
 
 /// A response time, when a channel reports one, is a finite number of

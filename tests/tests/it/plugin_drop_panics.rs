@@ -39,7 +39,7 @@ fn every_kind_of_object_reports_a_destructor_panic_to_the_host() {
         .map(|e| match e {
             HilError::Plugin { path, why } => {
                 assert_eq!(path, &lib);
-                assert!(why.ends_with("panicked in drop: boom in drop"), "{why}");
+                assert!(why.contains("panicked in drop: boom in drop"), "{why}");
                 why.split('`').nth(1).unwrap().to_string()
             }
             other => panic!("expected a plugin error, got {other:?}"),

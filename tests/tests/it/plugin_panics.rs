@@ -74,7 +74,12 @@ fn decide(p: &mut dyn Policy) -> hil_core::Result<hil_core::Decision> {
 
 fn observe(p: &mut dyn Policy) -> hil_core::Result<()> {
     let x = x();
-    p.observe(&Feedback::new(&x, ArmId(0), 1.0, 1))
+    p.observe(&Feedback::new(hil_core::Attempt {
+        context: &x,
+        arm: ArmId(0),
+        reward: 1.0,
+        t: 1,
+    }))
 }
 
 #[test]

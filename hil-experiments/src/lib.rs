@@ -38,6 +38,7 @@
 //! published figures**: they are not the paper's results, and every table and
 //! figure says so.
 
+pub mod bench;
 pub mod builtin;
 pub mod calibrate;
 pub mod claims;

@@ -12,26 +12,15 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use hil_workload::bundle::StudySummary;
-use hil_workload::study::{COLUMNS, Study};
+use hil_workload::study::Study;
+
+mod common;
 
 const CHILD_ENV: &str = "HIL_STUDY_BENCH_FILE";
 
-/// A valid study: one baseline survey, then `n` queries in one condition,
-/// a minute apart.
+/// One participant with one condition of `n` queries.
 fn write_study(path: &Path, n: usize) {
-    let mut text = COLUMNS.join(",");
-    text.push('\n');
-    text.push_str("p1,no_limitation,base,330,,,easy,,2,1,4,2,1,\n");
-    for i in 0..n {
-        let kinds = ["easy,mcq", "hard,open_ended", "easy,bounding_box"];
-        text.push_str(&format!(
-            "p1,no_limitation,c1,{},{},none,1,{},2,3,{},1,12.5\n",
-            60 * (i + 1),
-            kinds[i % 3],
-            1 + i % 5,
-            1 + (i / 5) % 5,
-        ));
-    }
+    let text = common::long_condition_csv(&[("p1", "no_limitation")], n);
     std::fs::write(path, text).expect("writing the benchmark study");
 }
 

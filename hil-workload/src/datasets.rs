@@ -148,6 +148,12 @@ impl HistoryPrefix {
         &self.all.records()[..self.len]
     }
 
+    /// The whole history this is a prefix of (one per condition, shared by
+    /// its pairs): pairs with the same one can be walked in one pass.
+    pub fn whole(&self) -> &Arc<QueryHistory> {
+        &self.all
+    }
+
     /// Number of queries in the prefix.
     pub fn len(&self) -> usize {
         self.len
@@ -165,6 +171,33 @@ impl HistoryPrefix {
         QueryHistory::from_records(self.records().to_vec())
             .expect("a prefix of a valid history is valid")
     }
+}
+
+/// The indices of `pairs` grouped by the whole history their prefixes share
+/// (one group per condition), each group ordered by prefix length: walking
+/// a group front to back visits its history's queries once, so work that
+/// is carried forward along a condition costs O(pairs + queries), not
+/// O(pairs × queries).
+pub(crate) fn by_shared_history(pairs: &[&TrainingPair]) -> Vec<Vec<usize>> {
+    // Groups in order of first appearance (not of address), so that
+    // anything summed group by group is the same on every run.
+    let mut group_of: std::collections::HashMap<*const QueryHistory, usize> =
+        std::collections::HashMap::new();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, p) in pairs.iter().enumerate() {
+        let g = *group_of
+            .entry(Arc::as_ptr(p.history.whole()))
+            .or_insert_with(|| {
+                groups.push(Vec::new());
+                groups.len() - 1
+            });
+        groups[g].push(i);
+    }
+    for g in &mut groups {
+        // Stable: pairs with one prefix keep their given order.
+        g.sort_by_key(|&i| pairs[i].history.len());
+    }
+    groups
 }
 
 /// One (query history, workload) training pair.

@@ -56,6 +56,20 @@ impl Gram {
         self.n += 1;
     }
 
+    /// Adds one dense row `x` (length k) with target `y`.
+    pub fn add_dense(&mut self, x: &[f64], y: f64) {
+        let k = self.k;
+        debug_assert_eq!(x.len(), k);
+        for (i, &vi) in x.iter().enumerate() {
+            self.b[i] += vi * y;
+            for (g, &vj) in self.g[i * k..(i + 1) * k].iter_mut().zip(x) {
+                *g += vi * vj;
+            }
+        }
+        self.yy += y * y;
+        self.n += 1;
+    }
+
     /// `self += sign · other` (same k).
     pub fn accumulate(&mut self, other: &Gram, sign: f64) {
         for (a, b) in self.g.iter_mut().zip(&other.g) {

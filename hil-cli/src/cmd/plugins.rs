@@ -79,9 +79,7 @@ pub fn run(args: PluginsArgs) -> hil_core::Result<()> {
             let opts = options(actions, dim, queries, attempts)?;
             check(&path, &params, &opts)
         }
-        PluginsCommand::Abi { json } => {
-            abi(json)
-        }
+        PluginsCommand::Abi { json } => abi(json),
     }
 }
 

@@ -14,23 +14,38 @@
 //! memoised numbers are the ones a scan computes, bit for bit, so results
 //! and checkpoint replay do not depend on it.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::sync::{Arc, Mutex};
+
+use super::linalg;
 
 /// Most context hashes whose products with the frozen rows are memoised; beyond
 /// it, products are computed every time (a live robot sees new contexts
 /// forever, and memory must stay bounded).
 pub(crate) const MEMO_LIMIT: usize = 4096;
 
+/// Most hashes of contexts seen once that are remembered (8 bytes each);
+/// beyond it the set starts over, so a context recurring only after this
+/// many others is not memoised.
+const SEEN_LIMIT: usize = 1 << 16;
+
 /// hash of x → (x, products of x with every frozen row).
 type ProductMemo = HashMap<u64, Vec<(Arc<[f64]>, Arc<[f64]>)>>;
+
+/// The memoised products, and the hashes of contexts seen once (the
+/// candidates for memoising).
+#[derive(Debug, Default)]
+struct Memo {
+    products: ProductMemo,
+    seen_once: HashSet<u64>,
+}
 
 /// Rows shared by clones, with the memo of their products.
 #[derive(Debug, Default)]
 struct Frozen {
     data: Vec<f64>,
     index: HashMap<u64, Vec<u32>>,
-    memo: Mutex<ProductMemo>,
+    memo: Mutex<Memo>,
 }
 
 /// Rows of length `dim`, each stored once (bitwise equality): the frozen
@@ -127,32 +142,47 @@ impl RowStore {
     /// (the frozen rows' part memoised per context).
     pub(crate) fn products(&self, x: &[f64], out: &mut Vec<f64>) {
         out.clear();
-        let dot = |r: &[f64]| super::linalg::dot(r, x);
         if !self.frozen.data.is_empty() {
             let h = hash_bits(x);
-            let hit = self.memo_lock().get(&h).and_then(|c| {
+            let mut memo = self.memo_lock();
+            let hit = memo.products.get(&h).and_then(|c| {
                 c.iter()
                     .find(|(k, _)| same_bits(k, x))
                     .map(|(_, g)| g.clone())
             });
             match hit {
-                Some(g) => out.extend_from_slice(&g),
-                None => {
-                    let g: Arc<[f64]> = self.frozen.data.chunks_exact(self.dim).map(dot).collect();
+                Some(g) => {
+                    drop(memo);
                     out.extend_from_slice(&g);
-                    let mut memo = self.memo_lock();
-                    // Counting hashes, not entries: collisions are rare, and
-                    // summing the buckets on every miss would cost O(memo).
-                    if memo.len() < MEMO_LIMIT {
-                        memo.entry(h).or_default().push((x.into(), g));
+                }
+                None => {
+                    // Only a context seen before is kept: a live robot's
+                    // contexts are all new, and copying each one (16 KB at
+                    // d = 2048) with its products into the memo cost more
+                    // than the memo saved. Replayed contexts pay one extra
+                    // scan, on their second sight.
+                    let keep = memo.products.len() < MEMO_LIMIT && !memo.seen_once.insert(h);
+                    if memo.seen_once.len() >= SEEN_LIMIT {
+                        memo.seen_once.clear();
+                    }
+                    drop(memo);
+                    linalg::dot_rows(&self.frozen.data, x, out);
+                    if keep {
+                        let g: Arc<[f64]> = out.as_slice().into();
+                        let mut memo = self.memo_lock();
+                        // Counting hashes, not entries: collisions are rare,
+                        // and summing the buckets would cost O(memo).
+                        if memo.products.len() < MEMO_LIMIT {
+                            memo.products.entry(h).or_default().push((x.into(), g));
+                        }
                     }
                 }
             }
         }
-        out.extend(self.data.chunks_exact(self.dim).map(dot));
+        linalg::dot_rows(&self.data, x, out);
     }
 
-    fn memo_lock(&self) -> std::sync::MutexGuard<'_, ProductMemo> {
+    fn memo_lock(&self) -> std::sync::MutexGuard<'_, Memo> {
         // A panic while the lock was held can only have left a memo entry
         // out, never a wrong one (entries are pushed whole).
         self.frozen
@@ -222,13 +252,35 @@ mod tests {
         assert_eq!(first, scan);
         assert_eq!(again, scan);
         assert_eq!(
-            s.memo_lock().len(),
+            s.memo_lock().products.len(),
             1,
-            "the memo is shared with the original"
+            "seen twice, memoised, and the memo is shared with the original"
         );
+        let mut memoised = Vec::new();
+        c.products(&x, &mut memoised);
+        assert_eq!(memoised, scan, "products read back from the memo");
         // Compaction keeps rows and indices consistent across the two parts.
         let map = c.compact(&[false, true, true]);
         assert_eq!(map, vec![u32::MAX, 0, 1]);
         assert_eq!(c.row(1), &[5.0, 6.0]);
+    }
+
+    #[test]
+    fn contexts_seen_once_are_not_copied_into_the_memo() {
+        let dim = 64;
+        let mut s = RowStore::new(dim);
+        for i in 0..10 {
+            s.insert(&vec![i as f64; dim]);
+        }
+        s.freeze();
+        let mut out = Vec::new();
+        for i in 0..100 {
+            let x: Vec<f64> = (0..dim).map(|j| (i * dim + j) as f64).collect();
+            s.products(&x, &mut out);
+            assert_eq!(out.len(), 10);
+        }
+        let memo = s.memo_lock();
+        assert_eq!(memo.products.len(), 0, "fresh contexts are never stored");
+        assert_eq!(memo.seen_once.len(), 100, "only their hashes are");
     }
 }

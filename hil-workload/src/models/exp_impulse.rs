@@ -6,8 +6,8 @@
 use hil_core::{HilError, QueryHistory, Result, Timestep, WorkloadModel, workload::check_wl0};
 use serde::{Deserialize, Serialize};
 
+use super::impulse_sums::ImpulseSums;
 use crate::datasets::TrainingPair;
-use crate::features::SparseRow;
 use crate::features::{KIND_FEATURES, one_hot_indices};
 use crate::fit::{BoxLsq, Gram};
 use hil_core::WorkloadInput;
@@ -56,25 +56,39 @@ impl ExpImpulseModel {
 
     /// Fits β by least squares for each λ and λ by a log-grid search
     /// refined by golden-section search (training MSE).
+    ///
+    /// Each λ costs O(pairs + queries): the impulse sums are carried along
+    /// each condition ([`ImpulseSums`]), not summed afresh per pair.
     pub fn fit(pairs: &[&TrainingPair]) -> Result<Self> {
         if pairs.is_empty() {
             return Err(HilError::invalid_input("training set", "no pairs to fit"));
         }
-        let sse = |log_l: f64| -> (f64, [f64; KIND_FEATURES]) {
+        let sums = ImpulseSums::new(pairs);
+        let mut features = Vec::new();
+        let mut targets = Vec::with_capacity(pairs.len());
+        let mut sse = |log_l: f64| -> (f64, [f64; KIND_FEATURES]) {
             let lambda = log_l.exp();
+            sums.features(lambda, &mut features);
+            // The target with the decayed WL_0 removed.
+            targets.clear();
+            targets.extend(
+                pairs
+                    .iter()
+                    .map(|p| p.target - p.wl0 * (-lambda * p.t as f64).exp()),
+            );
             let mut g = Gram::new(KIND_FEATURES);
-            let rows: Vec<(SparseRow, f64)> = pairs.iter().map(|p| Self::row(p, lambda)).collect();
-            for (row, _) in &rows {
-                g.add_row(row);
+            for (f, &y) in features.iter().zip(&targets) {
+                g.add_dense(f, y);
             }
             let beta = BoxLsq::plain(&g)
                 .solve(None)
                 .unwrap_or_else(|_| vec![0.0; KIND_FEATURES]);
             let mut b = [0.0; KIND_FEATURES];
             b.copy_from_slice(&beta);
-            let sse: f64 = rows
+            let sse: f64 = features
                 .iter()
-                .map(|(r, _)| (r.dot_prefix(&beta) - r.y).powi(2))
+                .zip(&targets)
+                .map(|(f, y)| (dot(f, &b) - y).powi(2))
                 .sum();
             (sse, b)
         };
@@ -125,25 +139,25 @@ impl ExpImpulseModel {
         Ok(m)
     }
 
-    /// The regression row of a pair for decay λ: features are the decayed
-    /// one-hot sums, the target has the decayed WL_0 removed.
-    fn row(p: &TrainingPair, lambda: f64) -> (SparseRow, f64) {
-        let mut f = [0.0; KIND_FEATURES];
-        for r in p.history.records().iter().filter(|r| r.t <= p.t) {
-            let w = (-lambda * (p.t - r.t) as f64).exp();
-            for j in one_hot_indices(&r.kind) {
-                f[j] += w;
-            }
-        }
-        let offset = p.wl0 * (-lambda * p.t as f64).exp();
-        (
-            SparseRow {
-                entries: f.iter().copied().enumerate().collect(),
-                y: p.target - offset,
-            },
-            offset,
-        )
+    /// The clamped predictions for `pairs` (each at its own time, from its
+    /// own prefix), in O(pairs + queries): what [`WorkloadModel::predict`]
+    /// gives pair by pair, to rounding.
+    pub fn predict_pairs(&self, pairs: &[&TrainingPair]) -> Vec<f64> {
+        let mut features = Vec::new();
+        ImpulseSums::new(pairs).features(self.decay, &mut features);
+        pairs
+            .iter()
+            .zip(&features)
+            .map(|(p, f)| {
+                let offset = p.wl0 * (-self.decay * p.t as f64).exp();
+                (offset + dot(f, &self.impulse)).clamp(0.0, 1.0)
+            })
+            .collect()
     }
+}
+
+fn dot(a: &[f64; KIND_FEATURES], b: &[f64; KIND_FEATURES]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 impl WorkloadModel for ExpImpulseModel {

@@ -10,6 +10,7 @@ pub mod average;
 pub mod constant;
 pub mod exp_impulse;
 pub mod granger;
+pub(crate) mod impulse_sums;
 
 use std::path::Path;
 

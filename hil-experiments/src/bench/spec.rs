@@ -9,11 +9,11 @@ use hil_core::{HilError, Result};
 use hil_policies::POLICY_TYPES;
 
 /// The bench's policy when none is named.
-pub(super) const DEFAULT_POLICY: &str = "linucb_qg";
+pub const DEFAULT_POLICY: &str = "linucb_qg";
 
 /// What the command line says about the policy.
 #[derive(Debug, Default)]
-pub(super) struct PolicySpec {
+pub struct PolicySpec {
     /// `--policy`: the config `type`.
     pub policy: Option<String>,
     /// `--policy-config`: a TOML file whose top-level keys are the table.
@@ -42,7 +42,7 @@ fn builtin_defaults(ty: &str) -> Vec<(&'static str, toml::Value)> {
 
 impl PolicySpec {
     /// The policy table, `type` included.
-    pub(super) fn table(&self) -> Result<toml::Table> {
+    pub fn table(&self) -> Result<toml::Table> {
         let mut table = match &self.file {
             Some(path) => read_table(path)?,
             None => toml::Table::new(),
@@ -108,7 +108,7 @@ impl PolicySpec {
 /// Parses the table as an experiment config's `[policy]` (plugin types
 /// included) and checks its parameters ([`PolicyConfig::validate`]), as an
 /// experiment file's are; errors name the offending key.
-pub(super) fn parse(table: &toml::Table) -> Result<Box<dyn PolicyConfig>> {
+pub fn parse(table: &toml::Table) -> Result<Box<dyn PolicyConfig>> {
     #[derive(serde::Deserialize)]
     struct Wrapper {
         #[serde(deserialize_with = "hil_plugin::component")]

@@ -4,6 +4,7 @@
 
 mod policy;
 mod reproduce;
+mod speech;
 
 use hil_core::Result;
 
@@ -20,6 +21,8 @@ enum BenchWhat {
     Policy(policy::PolicyArgs),
     /// Wall time of the full default `hil reproduce`.
     Reproduce(reproduce::ReproduceArgs),
+    /// Recognition accuracy, false accepts, re-asks and latency of spoken answers.
+    Speech(speech::SpeechBench),
 }
 
 /// Runs `hil bench`.
@@ -27,5 +30,6 @@ pub fn run(args: BenchArgs) -> Result<()> {
     match args.what {
         BenchWhat::Policy(a) => policy::run(a),
         BenchWhat::Reproduce(a) => reproduce::run(a),
+        BenchWhat::Speech(a) => speech::run(&a),
     }
 }

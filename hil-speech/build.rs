@@ -1,0 +1,9 @@
+//! Links Debian's pocketsphinx (5prealpha) and sphinxbase when the
+//! `engines` feature is on; without it the crate links nothing extra.
+fn main() {
+    println!("cargo:rerun-if-changed=build.rs");
+    if std::env::var_os("CARGO_FEATURE_ENGINES").is_some() {
+        println!("cargo:rustc-link-lib=pocketsphinx");
+        println!("cargo:rustc-link-lib=sphinxbase");
+    }
+}

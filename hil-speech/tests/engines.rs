@@ -1,0 +1,192 @@
+//! The channel with its engines (scripts/setup-speech installs them):
+//! built with `--features engines`, ignored in a plain run.
+#![cfg(feature = "engines")]
+
+use std::path::{Path, PathBuf};
+
+use hil_core::{Answer, ArmId, Context, Item, Query, QueryChannel, QueryKind};
+use hil_speech::channel::Outcome;
+use hil_speech::listener::ScriptedListener;
+use hil_speech::recognize::SphinxRecognizer;
+use hil_speech::source::{AudioSource, DeviceSource, FileSource};
+use hil_speech::tts::{EspeakVoice, TranscriptVoice};
+use hil_speech::{SpeechChannel, SpeechSettings};
+
+const MODEL: &str = hil_speech::recognize::DEFAULT_MODEL_DIR;
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hil-speech-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn query(t: u64) -> Query {
+    Query::new(
+        t,
+        Item::new(0, "banana"),
+        QueryKind::default(),
+        hil_envs::feeding::action_space(),
+        Context::new(vec![0.0]).unwrap(),
+    )
+}
+
+fn channel(source: Box<dyn AudioSource>, dir: &Path) -> (SpeechChannel, TranscriptVoice) {
+    let voice = TranscriptVoice::default();
+    let settings = SpeechSettings {
+        audio_dir: Some(dir.join("audio")),
+        ..Default::default()
+    };
+    let recognizer = Box::new(SphinxRecognizer::new(Path::new(MODEL)).unwrap());
+    (
+        SpeechChannel::new(Box::new(voice.clone()), source, recognizer, settings).unwrap(),
+        voice,
+    )
+}
+
+#[test]
+#[ignore = "needs scripts/setup-speech"]
+fn spoken_answers_become_the_answers_and_are_kept_beside_the_record() {
+    let dir = scratch("answers");
+    let phrases = ["v s ninety", "option five", "i don't know"];
+    let script = {
+        let mut i = 0;
+        Box::new(move |_q: &Query, _a: usize| {
+            i += 1;
+            phrases.get(i - 1).map(|s| s.to_string())
+        })
+    };
+    let listener = ScriptedListener::new(EspeakVoice::default(), dir.clone(), script);
+    let (mut ch, voice) = channel(Box::new(listener), &dir);
+    assert_eq!(ch.ask(&query(1)).unwrap().expert_arm, Some(ArmId(1)));
+    assert_eq!(ch.ask(&query(2)).unwrap().expert_arm, Some(ArmId(4)));
+    assert_eq!(ch.ask(&query(3)).unwrap().answer, Answer::Declined);
+    assert!(voice.said()[0].contains("Option two: v s ninety."));
+    // WAV (16 kHz) and JSON for each utterance.
+    let wav = hil_speech::audio::Audio::read_wav(&dir.join("audio/step-1-turn-0.wav")).unwrap();
+    assert_eq!(wav.rate, 16_000);
+    let json = std::fs::read_to_string(dir.join("audio/step-1-turn-0.json")).unwrap();
+    assert!(json.contains("\"transcript\": \"v s ninety\""), "{json}");
+    assert!(json.contains("latency_ms"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+#[ignore = "needs scripts/setup-speech"]
+fn silence_is_asked_again_then_recorded_as_no_answer() {
+    let dir = scratch("silence");
+    let (mut ch, voice) = channel(Box::new(FileSource::new([])), &dir);
+    let r = ch.ask(&query(1)).unwrap();
+    assert_eq!(r.answer, Answer::TimedOut);
+    assert_eq!(ch.turns.len(), 3);
+    assert!(
+        ch.turns
+            .iter()
+            .all(|t| t.hearing.outcome == Outcome::Silence)
+    );
+    assert_eq!(
+        voice
+            .said()
+            .iter()
+            .filter(|s| s.starts_with("Sorry"))
+            .count(),
+        2
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+#[ignore = "needs scripts/setup-speech"]
+fn clipping_is_asked_again_and_a_wrong_rate_is_resampled() {
+    let dir = scratch("clip");
+    let voice = EspeakVoice::default();
+    // espeak-ng speaks at 22.05 kHz: played as it is, it is resampled.
+    let clean = hil_speech::listener::say(&voice, "option three", &dir).unwrap();
+    assert_ne!(clean.rate, 16_000);
+    clean.write_wav(&dir.join("clean.wav")).unwrap();
+    let mut loud = clean.clone();
+    loud.samples
+        .iter_mut()
+        .for_each(|s| *s = (*s * 50.0).clamp(-1.0, 1.0));
+    loud.write_wav(&dir.join("loud.wav")).unwrap();
+    let source = FileSource::new([dir.join("loud.wav"), dir.join("clean.wav")]);
+    let (mut ch, voice_out) = channel(Box::new(source), &dir);
+    let r = ch.ask(&query(1)).unwrap();
+    assert_eq!(r.expert_arm, Some(ArmId(2)));
+    assert_eq!(ch.turns[0].hearing.outcome, Outcome::Clipped);
+    assert!(voice_out.said()[1].contains("too loud"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+#[ignore = "needs scripts/setup-speech"]
+fn a_missing_device_is_named_with_how_to_list_devices() {
+    let mut dev = DeviceSource {
+        device: "hw:97,0".into(),
+        rate: 16_000,
+        seconds: 2,
+    };
+    let why = dev.probe().unwrap_err().to_string();
+    assert!(
+        why.contains("hw:97,0") && why.contains("arecord -L"),
+        "{why}"
+    );
+    let why = dev.open(&query(1), 0).err().unwrap().to_string();
+    assert!(
+        why.contains("hw:97,0") && why.contains("arecord -L"),
+        "{why}"
+    );
+}
+
+#[test]
+#[ignore = "needs scripts/setup-speech"]
+fn ctrl_c_stops_between_utterances() {
+    let dir = scratch("stop");
+    let (mut ch, _) = channel(Box::new(FileSource::new([])), &dir);
+    ch.stop_flag()
+        .store(true, std::sync::atomic::Ordering::SeqCst);
+    assert!(matches!(
+        ch.ask(&query(1)),
+        Err(hil_core::HilError::Channel { .. })
+    ));
+    assert!(ch.turns.is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Answers the query's best action by its number, a region for a box.
+fn oracle_script() -> hil_speech::listener::Script {
+    Box::new(|q: &Query, _attempt: usize| {
+        Some(match q.kind.response {
+            hil_core::ResponseType::BoundingBox => "center".to_string(),
+            _ => format!(
+                "option {}",
+                hil_speech::grammar::number_words(q.oracle_best.map_or(0, |a| a.0) as u64 + 1)
+            ),
+        })
+    })
+}
+
+#[test]
+#[ignore = "needs scripts/setup-speech"]
+fn the_channel_passes_the_conformance_suite() {
+    let dir = scratch("conformance");
+    let listener = ScriptedListener::new(EspeakVoice::default(), dir.clone(), oracle_script());
+    let (mut ch, _) = channel(Box::new(listener), &dir);
+    let report = hil_conformance::check_query_channel(&mut ch, 12).unwrap();
+    assert_eq!(report.subject, "speech");
+    assert!(!report.passed.is_empty(), "{report:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+#[ignore = "needs scripts/setup-speech"]
+fn a_replayed_file_that_starts_on_its_first_word_is_heard_whole() {
+    let dir = scratch("replay");
+    // espeak-ng's own file: the word starts at once, no silence before it.
+    EspeakVoice::default()
+        .synthesize_to("option one", &dir.join("one.wav"))
+        .unwrap();
+    let (mut ch, _) = channel(Box::new(FileSource::new([dir.join("one.wav")])), &dir);
+    assert_eq!(ch.ask(&query(1)).unwrap().expert_arm, Some(ArmId(0)));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

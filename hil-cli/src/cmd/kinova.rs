@@ -13,11 +13,10 @@
 //!   n_success and n_q per plate and their mean ± standard error per method.
 //!   This file only reads arguments, renders keyframes and prints.
 
-use crate::out::{note, out, outln};
+use crate::out::{note, outln};
 use std::path::{Path, PathBuf};
 
 use hil_core::{HilError, Result};
-use hil_experiments::results_page::ResultsPage;
 use hil_experiments::user_study::text::{NOTE, over_seeds_text, result_text};
 use hil_experiments::user_study::{Plate, UserStudyConfig};
 use hil_kinova_mujoco::calibration_text::{
@@ -244,7 +243,7 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         if args.json {
             return print_json(&report);
         }
-        return emit(
+        return super::emit_report(
             &run_text(&opts, &report),
             args.write_doc.as_deref(),
             CALIBRATION_TITLE,
@@ -253,7 +252,7 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
     if args.json {
         return print_json(&over);
     }
-    emit(
+    super::emit_report(
         &calibration_over_seeds_text(&over),
         args.write_doc.as_deref(),
         CALIBRATION_TITLE,
@@ -339,7 +338,7 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
     if args.json {
         print_json_with_note(&run.result)?;
     } else {
-        emit(
+        super::emit_report(
             &result_text(&run.result),
             args.write_doc.as_deref(),
             USER_STUDY_TITLE,
@@ -354,23 +353,6 @@ fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
 /// Headings of the results pages `--write-doc` keeps.
 const CALIBRATION_TITLE: &str = "Kinova simulator calibration against the published success rates";
 const USER_STUDY_TITLE: &str = "The user-study protocol in the Kinova simulation";
-
-/// Prints a report and, with `--write-doc FILE`, keeps it as a results
-/// page naming this command line.
-fn emit(report: &str, write_doc: Option<&Path>, title: &str) -> Result<()> {
-    out!("{report}")?;
-    if let Some(path) = write_doc {
-        let command = super::command_line();
-        ResultsPage {
-            title,
-            command: &command,
-            report,
-        }
-        .write(path)?;
-        note!("wrote {}", path.display());
-    }
-    Ok(())
-}
 
 /// `value`'s JSON object with the [`NOTE`] beside its fields, printed.
 fn print_json_with_note(value: &impl serde::Serialize) -> Result<()> {
@@ -414,7 +396,7 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
     if args.json {
         return print_json_with_note(&over);
     }
-    emit(
+    super::emit_report(
         &over_seeds_text(&over),
         args.write_doc.as_deref(),
         USER_STUDY_TITLE,

@@ -1,5 +1,7 @@
 //! One module per subcommand.
 
+use std::path::Path;
+
 pub mod bench;
 pub mod data;
 #[cfg(feature = "physics")]
@@ -36,7 +38,6 @@ impl Threads {
 /// This run's command line as a person would type it (`hil` and the
 /// arguments, shell-quoted where needed), for results pages to name the
 /// command that wrote them.
-#[cfg_attr(not(feature = "physics"), allow(dead_code))]
 pub fn command_line() -> String {
     let quote = |a: String| {
         let plain = !a.is_empty()
@@ -56,4 +57,22 @@ pub fn command_line() -> String {
         )
         .collect::<Vec<_>>()
         .join(" ")
+}
+
+/// Prints a report and, with `--write-doc FILE`, keeps it as a results
+/// page ([`hil_experiments::results_page`]) naming this command line, so
+/// that a figure a README cites comes from the command that measured it.
+pub fn emit_report(report: &str, write_doc: Option<&Path>, title: &str) -> hil_core::Result<()> {
+    crate::out::out!("{report}")?;
+    if let Some(path) = write_doc {
+        let command = command_line();
+        hil_experiments::results_page::ResultsPage {
+            title,
+            command: &command,
+            report,
+        }
+        .write(path)?;
+        crate::out::note!("wrote {}", path.display());
+    }
+    Ok(())
 }

@@ -20,6 +20,10 @@ pub struct SpeechBench {
     /// Print the rows as JSON.
     #[arg(long)]
     json: bool,
+    /// Also keep the printed table as a Markdown results page at this path
+    /// (e.g. docs/results/speech-bench.md), naming this command line.
+    #[arg(long, value_name = "FILE", conflicts_with = "json")]
+    write_doc: Option<std::path::PathBuf>,
 }
 
 #[cfg(feature = "speech")]
@@ -44,17 +48,22 @@ pub fn run(a: &SpeechBench) -> Result<()> {
                 .map_err(|e| hil_core::HilError::serde("bench rows", e))?
         )?;
     } else {
-        crate::out::outln!(
-            "corpus: every answer of every query kind, espeak-ng voices {} at {} wpm, pink noise (sox); threshold {}",
+        let report = format!(
+            "corpus: every answer of every query kind, espeak-ng voices {} at {} wpm, pink noise (sox); threshold {}\n{}",
             a.voices.join(", "),
             a.rates
                 .iter()
                 .map(u32::to_string)
                 .collect::<Vec<_>>()
                 .join("/"),
-            a.threshold
+            a.threshold,
+            bench::table(&rows)
+        );
+        crate::cmd::emit_report(
+            &report,
+            a.write_doc.as_deref(),
+            "Spoken answers: recognition on a synthetic corpus",
         )?;
-        crate::out::out!("{}", bench::table(&rows))?;
     }
     Ok(())
 }

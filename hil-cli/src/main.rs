@@ -39,6 +39,8 @@ enum Command {
     Study(cmd::study::StudyArgs),
     /// Inspect plugin libraries and check their types for conformance.
     Plugins(cmd::plugins::PluginsArgs),
+    /// Interaction logs: make a key for keyed logs, verify a log's chain.
+    Record(cmd::record::RecordArgs),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +57,7 @@ fn main() -> ExitCode {
         Command::Workload(args) => cmd::workload::run(args),
         Command::Study(args) => cmd::study::run(args),
         Command::Plugins(args) => cmd::plugins::run(args),
+        Command::Record(args) => cmd::record::run(args),
     };
     // Every command has dropped its components by now: a plugin object
     // whose destructor panicked (in `hil reproduce`, `hil demo`, ...) fails

@@ -40,6 +40,7 @@ pub mod metrics;
 pub mod policy;
 pub mod query;
 pub mod record;
+pub mod secrets;
 pub mod session;
 pub mod time;
 pub mod workload;

@@ -18,8 +18,8 @@ use crate::experiment::{Experiment, ExperimentSummary};
 /// outcomes, episode summaries, checkpoints), and only then appends. It
 /// does not restore the last checkpoint and trust what came before: an
 /// episode summary edited to disagree with its steps, or a header whose
-/// config was changed, would then pass unseen (and the chain, having no
-/// key, can be recomputed by whoever edits the log). The logged answers
+/// config was changed, would then pass unseen (and an unkeyed chain can be
+/// recomputed by whoever edits the log). The logged answers
 /// are given back in order, so no person is asked twice.
 struct ResumePlan {
     expected: Vec<LoggedRecord>,

@@ -46,7 +46,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use hil_core::record::{Header, LoggedSession, RecordLog};
+use hil_core::record::{Header, LoggedSession, RecordKey, RecordLog};
 use hil_core::{EpisodeMetrics, HilError, Result, SessionObserver, StepEvent};
 
 use crate::{Experiment, ExperimentSummary, run_recorded};
@@ -66,13 +66,25 @@ impl Recording {
     /// Records into a new log at `path` (it must not exist yet) under
     /// `header`.
     pub fn create(path: &Path, header: Header) -> Result<Self> {
-        Ok(Self::New(RecordLog::create(path, header)?))
+        Self::create_with_key(path, header, None)
+    }
+
+    /// [`Recording::create`], with the log keyed by `key` if given
+    /// ([`RecordLog::create_with_key`]).
+    pub fn create_with_key(path: &Path, header: Header, key: Option<RecordKey>) -> Result<Self> {
+        Ok(Self::New(RecordLog::create_with_key(path, header, key)?))
     }
 
     /// Continues the session recorded at `path`: opens the log, holding
     /// its one-writer lock from now on, and verifies every line.
     pub fn open(path: &Path) -> Result<Self> {
-        let (log, logged) = RecordLog::open(path)?;
+        Self::open_with_key(path, None)
+    }
+
+    /// [`Recording::open`] for a log that may be keyed: `key` must be its
+    /// key ([`RecordLog::open_with_key`]).
+    pub fn open_with_key(path: &Path, key: Option<RecordKey>) -> Result<Self> {
+        let (log, logged) = RecordLog::open_with_key(path, key)?;
         Ok(Self::Resume(log, Box::new(logged)))
     }
 
@@ -107,6 +119,27 @@ impl Run {
     /// resolve against its directory) and, with `log`, records into a new
     /// interaction log there.
     pub fn from_config(config: &Path, log: Option<&Path>) -> Result<Self> {
+        Self::from_config_with_key(config, log, None)
+    }
+
+    /// [`Run::from_config`], with the log keyed by `key` if given (a key
+    /// without a log is refused: there is nothing to key).
+    pub fn from_config_with_key(
+        config: &Path,
+        log: Option<&Path>,
+        key: Option<RecordKey>,
+    ) -> Result<Self> {
+        if log.is_none()
+            && let Some(key) = &key
+        {
+            return Err(HilError::invalid_input(
+                "record key",
+                format!(
+                    "a record key ({}) was given but no log to key",
+                    key.path().display()
+                ),
+            ));
+        }
         let text = hil_core::files::read_text(config, hil_core::files::limits::CONFIG)?;
         let cfg = crate::parse_experiment(&text, config)?;
         // Absolute, so that a resume from another directory finds the
@@ -127,7 +160,7 @@ impl Run {
                     experiment.seed,
                     experiment.episodes,
                 );
-                Recording::create(path, header)?
+                Recording::create_with_key(path, header, key)?
             }
             None => Recording::Off,
         };
@@ -140,7 +173,12 @@ impl Run {
     /// Continues the session recorded in `log` ([`Recording::open`]),
     /// built from the config its header holds.
     pub fn resume(log: &Path) -> Result<Self> {
-        Self::resume_from(Recording::open(log)?)
+        Self::resume_with_key(log, None)
+    }
+
+    /// [`Run::resume`] of a log that may be keyed: `key` must be its key.
+    pub fn resume_with_key(log: &Path, key: Option<RecordKey>) -> Result<Self> {
+        Self::resume_from(Recording::open_with_key(log, key)?)
     }
 
     /// Continues the session `recording` resumes (from

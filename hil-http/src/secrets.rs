@@ -3,53 +3,19 @@
 //! only their owner may read, so that a link or key stays the same across
 //! restarts without being readable by other users of the machine.
 
-use std::io::Write;
 use std::path::Path;
 
 use hil_core::{HilError, Result};
 
 use crate::guard::random_token;
 
-/// Writes a new secret file readable and writable by its owner only
-/// (mode 0600, set when the file is created, so it is never readable by
-/// others, not even for a moment). Fails if the file exists.
-pub fn create_private(path: &Path, contents: &[u8]) -> Result<()> {
-    let mut options = std::fs::OpenOptions::new();
-    options.write(true).create_new(true);
-    #[cfg(unix)]
-    std::os::unix::fs::OpenOptionsExt::mode(&mut options, 0o600);
-    let mut file = options
-        .open(path)
-        .map_err(|e| HilError::io("creating", path, e))?;
-    file.write_all(contents)
-        .and_then(|()| file.sync_all())
-        .map_err(|e| HilError::io("writing", path, e))
-}
+pub use hil_core::secrets::create_private;
 
-/// Reads a secret file, refusing one that other users may read or write
-/// (the error says how to fix it).
+/// Reads a secret file (at most [`hil_core::files::limits::CONFIG`]
+/// bytes), refusing one that other users may read or write
+/// ([`hil_core::secrets::read_private`]).
 pub fn read_private(path: &Path) -> Result<String> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let meta = std::fs::metadata(path).map_err(|e| HilError::io("reading", path, e))?;
-        let mode = meta.permissions().mode() & 0o777;
-        if mode & 0o077 != 0 {
-            return Err(HilError::io(
-                "reading",
-                path,
-                std::io::Error::new(
-                    std::io::ErrorKind::PermissionDenied,
-                    format!(
-                        "this secret is open to other users (mode {mode:o}); make it the \
-                         owner's only with `chmod 600 {}`",
-                        path.display()
-                    ),
-                ),
-            ));
-        }
-    }
-    hil_core::files::read_text(path, hil_core::files::limits::CONFIG)
+    hil_core::secrets::read_private(path, hil_core::files::limits::CONFIG)
 }
 
 /// The token kept in `path`, made (with [`random_token`]) and stored

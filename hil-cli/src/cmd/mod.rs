@@ -11,6 +11,7 @@ pub mod kinova;
 #[path = "without_physics.rs"]
 pub mod kinova;
 pub mod plugins;
+pub mod record;
 pub mod reproduce;
 pub mod run;
 pub mod study;

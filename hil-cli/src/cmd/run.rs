@@ -26,6 +26,13 @@ pub struct RunArgs {
     /// the line at fault.
     #[arg(long, value_name = "LOG", conflicts_with_all = ["config", "log"])]
     pub resume: Option<PathBuf>,
+    /// Key the interaction log with the secret key in FILE (made by `hil
+    /// record keygen`; refused if its group or others may read it): every
+    /// line is chained with HMAC-SHA256, so an edited log cannot be
+    /// re-chained without the key. With --resume, the key of a keyed log
+    /// (required for one). Keep FILE outside the log's folder.
+    #[arg(long, value_name = "FILE")]
+    pub record_key: Option<PathBuf>,
     /// Write every step event to this JSONL file.
     #[arg(long)]
     pub events: Option<PathBuf>,
@@ -94,13 +101,21 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
         }
     };
 
-    install_interrupt_notice(match &start {
-        Start::Fresh { log, .. } => log.clone(),
-        Start::Resume(log) => Some(log.clone()),
-    });
+    install_interrupt_notice(
+        match &start {
+            Start::Fresh { log, .. } => log.clone(),
+            Start::Resume(log) => Some(log.clone()),
+        },
+        args.record_key.clone(),
+    );
+    let key = args
+        .record_key
+        .as_deref()
+        .map(hil_core::record::RecordKey::read)
+        .transpose()?;
     let run = match &start {
-        Start::Fresh { config, log } => Run::from_config(config, log.as_deref())?,
-        Start::Resume(log) => Run::resume(log)?,
+        Start::Fresh { config, log } => Run::from_config_with_key(config, log.as_deref(), key)?,
+        Start::Resume(log) => Run::resume_with_key(log, key)?,
     };
     if !quiet && let Some(logged) = run.recording.logged() {
         note!(
@@ -134,7 +149,7 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
 /// (steps are fsync'ed before the robot acts); a line cut short by the
 /// interrupt is discarded by `--resume`.
 #[cfg(unix)]
-fn install_interrupt_notice(log: Option<PathBuf>) {
+fn install_interrupt_notice(log: Option<PathBuf>, key: Option<PathBuf>) {
     use signal_hook::consts::{SIGINT, SIGTERM};
     let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
         return; // the default behaviour (ending the process) still applies
@@ -145,8 +160,11 @@ fn install_interrupt_notice(log: Option<PathBuf>) {
             if signals.forever().next().is_some() {
                 match &log {
                     Some(p) => note!(
-                        "\ninterrupted: every answered step is in {0}; continue with `hil run --resume {0}`",
-                        p.display()
+                        "\ninterrupted: every answered step is in {0}; continue with `hil run --resume {0}{1}`",
+                        p.display(),
+                        key.as_ref()
+                            .map(|k| format!(" --record-key {}", k.display()))
+                            .unwrap_or_default()
                     ),
                     None => note!(
                         "\ninterrupted: no interaction log was kept (run with --log LOG to be able to resume)"
@@ -158,7 +176,7 @@ fn install_interrupt_notice(log: Option<PathBuf>) {
 }
 
 #[cfg(not(unix))]
-fn install_interrupt_notice(_log: Option<PathBuf>) {}
+fn install_interrupt_notice(_log: Option<PathBuf>, _key: Option<PathBuf>) {}
 
 /// Tells the researcher where the person answers (a web channel's URL).
 /// Printed even with --quiet: without it nobody can answer.

@@ -15,6 +15,7 @@ mod data_inputs;
 mod kinova;
 #[cfg(feature = "physics")]
 mod kinova_seeds;
+mod record_cmd;
 mod reproduce;
 mod resume;
 mod run_reliability;

@@ -42,6 +42,12 @@ pub struct Header {
     /// SHA-256 of `config` (lower-case hex): checked when the log is read,
     /// so the config a session resumes with is the one it started with.
     pub config_digest: String,
+    /// For a keyed log ([`super::key`]), the id of its key (never the key
+    /// itself), so a reader knows a key is needed and which; absent (not
+    /// written at all) in an unkeyed log. Part of the header's chained
+    /// content, so it cannot be changed without breaking the chain.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub record_key: Option<String>,
 }
 
 impl Header {
@@ -62,6 +68,7 @@ impl Header {
             base_dir: base_dir.into(),
             config: config.into(),
             config_digest: super::chain::digest_hex(config),
+            record_key: None,
         }
     }
 }

@@ -12,6 +12,7 @@ use crate::error::{HilError, Result};
 use crate::files::{limits, read_bytes};
 use crate::record::chain::{self, Chain};
 use crate::record::format::{FORMAT_NAME, FORMAT_VERSION, Header, Record};
+use crate::record::key::RecordKey;
 use crate::record::lock;
 
 /// An append-only JSONL file whose every line reaches the disk (fsync)
@@ -58,6 +59,18 @@ impl RecordLog {
     /// Refuses to overwrite an existing file (it may hold a session to
     /// resume).
     pub fn create(path: &Path, header: Header) -> Result<Self> {
+        Self::create_with_key(path, header, None)
+    }
+
+    /// [`RecordLog::create`], keyed with `key` if given: the header records
+    /// the key's id and every line is chained with HMAC-SHA256
+    /// ([`super::key`]).
+    pub fn create_with_key(
+        path: &Path,
+        mut header: Header,
+        key: Option<RecordKey>,
+    ) -> Result<Self> {
+        header.record_key = key.as_ref().map(RecordKey::id);
         let file = OpenOptions::new()
             .write(true)
             .create_new(true)
@@ -65,6 +78,9 @@ impl RecordLog {
             .map_err(|e| HilError::io("creating", path, e))?;
         sync_parent_dir(path);
         let mut log = Self::locked(path, file)?;
+        if let Some(key) = key {
+            log.chain = Chain::start_keyed(key);
+        }
         log.append(&Record::Header(header))?;
         Ok(log)
     }
@@ -76,8 +92,17 @@ impl RecordLog {
     /// robot never acted on it) and positions for appending.
     ///
     /// Every error names the file, and where a line is at fault, the line
-    /// and field ([`HilError::Data`]).
+    /// and field ([`HilError::Data`]). A keyed log is refused (at line 1,
+    /// field `record_key`): open it with [`RecordLog::open_with_key`].
     pub fn open(path: &Path) -> Result<(Self, LoggedSession)> {
+        Self::open_with_key(path, None)
+    }
+
+    /// [`RecordLog::open`] with the log's key, if it is keyed. A key for an
+    /// unkeyed log, or one whose id is not the header's, is refused at
+    /// line 1 (field `record_key`); a line whose HMAC does not verify, at
+    /// that line (field `chain`).
+    pub fn open_with_key(path: &Path, key: Option<RecordKey>) -> Result<(Self, LoggedSession)> {
         // Opening for writing never blocks (not even on a FIFO); anything
         // that is not a regular file is then refused by `read_bytes`.
         let file = OpenOptions::new()
@@ -90,7 +115,7 @@ impl RecordLog {
         let bytes = read_bytes(path, limits::LOG)?;
         let complete = bytes.iter().rposition(|b| *b == b'\n').map_or(0, |p| p + 1);
         let truncated_bytes = (bytes.len() - complete) as u64;
-        let (session, chain) = parse(path, &bytes[..complete], truncated_bytes)?;
+        let (session, chain) = parse(path, &bytes[..complete], truncated_bytes, key)?;
         if truncated_bytes > 0 {
             log.file
                 .set_len(complete as u64)
@@ -103,6 +128,17 @@ impl RecordLog {
         log.lines = session.records.len() + 1;
         log.chain = chain;
         Ok((log, session))
+    }
+
+    /// Reads and verifies the log at `path` as [`RecordLog::open_with_key`]
+    /// does, without taking its lock or changing it (an incomplete last
+    /// line is reported in `truncated_bytes`, not cut off): what
+    /// `hil record verify` runs.
+    pub fn verify(path: &Path, key: Option<RecordKey>) -> Result<LoggedSession> {
+        let bytes = read_bytes(path, limits::LOG)?;
+        let complete = bytes.iter().rposition(|b| *b == b'\n').map_or(0, |p| p + 1);
+        let truncated_bytes = (bytes.len() - complete) as u64;
+        Ok(parse(path, &bytes[..complete], truncated_bytes, key)?.0)
     }
 
     /// Locks `file` (the log at `path`) and records this process as its
@@ -134,7 +170,7 @@ impl RecordLog {
     }
 
     fn write_line(&mut self, content: &str, advance: bool) -> Result<()> {
-        let mut chain = self.chain;
+        let mut chain = self.chain.clone();
         let mut line = chain.seal(content, advance);
         line.push('\n');
         // One write call per line: a kill leaves either the whole line or a
@@ -227,9 +263,39 @@ fn check_version(raw: &str) -> std::result::Result<(), (&'static str, String)> {
     Err(("version", why))
 }
 
+/// The chain a log with header `h` is verified with, given the key the
+/// reader holds: refused unless both or neither say the log is keyed, and
+/// with the same key.
+fn start_chain(h: &Header, key: Option<RecordKey>) -> std::result::Result<Chain, String> {
+    match (&h.record_key, key) {
+        (None, None) => Ok(Chain::start()),
+        (Some(id), None) => Err(format!(
+            "the log is keyed (key id {id}): it verifies only with its key \
+             (`--record-key FILE` / `--key FILE`)"
+        )),
+        (None, Some(key)) => Err(format!(
+            "a key was given ({}) but the log is not keyed: it was written without a key, or a \
+             keyed log was re-chained without one",
+            key.path().display()
+        )),
+        (Some(id), Some(key)) if *id != key.id() => Err(format!(
+            "the log was keyed with key id {id}, but the key in {} has id {}: the wrong key, \
+             or the header was changed",
+            key.path().display(),
+            key.id()
+        )),
+        (Some(_), Some(key)) => Ok(Chain::start_keyed(key)),
+    }
+}
+
 /// Parses and verifies the complete lines of a log; returns what it holds
 /// and the chain value after its last line.
-fn parse(path: &Path, bytes: &[u8], truncated_bytes: u64) -> Result<(LoggedSession, Chain)> {
+fn parse(
+    path: &Path,
+    bytes: &[u8],
+    truncated_bytes: u64,
+    mut key: Option<RecordKey>,
+) -> Result<(LoggedSession, Chain)> {
     let data_err = |line: usize, field: &str, why: String| HilError::Data {
         path: path.to_path_buf(),
         record: line,
@@ -276,6 +342,11 @@ fn parse(path: &Path, bytes: &[u8], truncated_bytes: u64) -> Result<(LoggedSessi
                  differs from `config_digest`)"
                     .into(),
             ));
+        }
+        if let Record::Header(h) = &record
+            && line == 1
+        {
+            chain = start_chain(h, key.take()).map_err(|why| data_err(1, "record_key", why))?;
         }
         chain
             .check(digest, &content, !matches!(record, Record::Resumed { .. }))

@@ -4,13 +4,13 @@
 //! # Format
 //!
 //! One JSON object per line, tagged by its `record` field (see [`Record`]).
-//! Every line starts with a `chain` field, the SHA-256 of the previous
-//! line's `chain` and the line's own content ([`chain`]), which makes the
-//! log tamper-evident.
+//! Every line starts with a `chain` field, the SHA-256 (in a keyed log, the
+//! HMAC-SHA256) of the previous line's `chain` and the line's own content
+//! ([`chain`]), which makes the log tamper-evident.
 //!
 //! | record | when | fields |
 //! |---|---|---|
-//! | `header` | first line | `format` (`hil-interaction-record`), `version` (3), `seed`, `episodes`, `config_path`, `base_dir`, `config` (the experiment TOML, verbatim), `config_digest` (its SHA-256) |
+//! | `header` | first line | `format` (`hil-interaction-record`), `version` (3), `seed`, `episodes`, `config_path`, `base_dir`, `config` (the experiment TOML, verbatim), `config_digest` (its SHA-256), and in a keyed log `record_key` (the key's id) |
 //! | `episode_start` | episode begins | `episode`, `seed` |
 //! | `step` | decided, **fsync'ed before the robot acts** | `episode`, `step`: `t`, `item_index`, `item_label`, `attempt`, `context`, `decision` (`act` / `query` with its `kind` = response type, difficulty, distraction, and `fallback` / `follow_expert`), `diagnostics`, `response` (answer, expert arm, response time; a `timed_out` answer means the policy acted on its own), `arm`, `wl_t` (WL_t = f(WL_0, Q_t) at this step) |
 //! | `outcome` | after execution, fsync'ed | `episode`, `t`, `outcome` (`success`, `success_probability`) |
@@ -31,8 +31,13 @@
 //! `config_digest`. A flipped bit anywhere (an `episode_end` before the
 //! last checkpoint included), an edited checkpoint, removed or reordered
 //! lines, a header spliced from another log, or an edited config are
-//! refused with the line at fault. The chain has no key: it catches
-//! corruption and edits, not a forger who recomputes it.
+//! refused with the line at fault. An unkeyed chain catches corruption
+//! and edits, not a forger who recomputes it; a keyed one
+//! ([`RecordLog::create_with_key`], [`key`]) is chained with HMAC-SHA256
+//! under a secret key kept outside the log, so only a key holder can
+//! re-chain it. The header names the key's id: a keyed log is opened only
+//! with its key ([`RecordLog::open_with_key`]), and a key is refused for an
+//! unkeyed log.
 //!
 //! # Resuming
 //!
@@ -85,6 +90,7 @@
 
 pub mod chain;
 pub mod format;
+pub mod key;
 pub mod lock;
 pub mod log;
 pub mod recorder;
@@ -93,6 +99,7 @@ pub mod replay;
 use crate::event::StepEvent;
 
 pub use format::{FORMAT_NAME, FORMAT_VERSION, Header, Record};
+pub use key::RecordKey;
 pub use log::{LoggedRecord, LoggedSession, RecordLog};
 pub use recorder::Recorder;
 

@@ -10,6 +10,7 @@ mod experiment_config;
 mod protocol_components;
 mod record;
 mod record_fuzz;
+mod record_keyed;
 mod run_flow;
 mod session_checks;
 mod testbed;

@@ -15,8 +15,6 @@
 //! - The loop: [`Session`] runs episodes with the paper's semantics and
 //!   emits one [`StepEvent`] per step; [`EpisodeMetrics`] computes the
 //!   paper's metrics from those events.
-//! - The interaction record: [`record`] logs every step durably and
-//!   resumes killed sessions.
 //! - Size-limited file reading ([`files`]) and [`ConfigError`], the located
 //!   error every config loader returns.
 //!
@@ -25,7 +23,9 @@
 //! is checked against, TOML error location),
 //! `hil-plugin` (plugins loaded from shared libraries, `declare_plugin!`),
 //! `hil-conformance` (the conformance suites for implementers),
-//! `hil-textdata` (CSV and line-table readers).
+//! `hil-textdata` (CSV and line-table readers),
+//! `hil-record` (the interaction record: every step logged durably under a
+//! hash chain, keyed when it must resist forgery, and resumed after a kill).
 #![deny(unsafe_code)]
 
 pub mod action;
@@ -39,7 +39,6 @@ pub mod files;
 pub mod metrics;
 pub mod policy;
 pub mod query;
-pub mod record;
 pub mod secrets;
 pub mod session;
 pub mod time;

@@ -1,13 +1,13 @@
 //! Running an [`Experiment`] with its interaction record: [`run_recorded`]
 //! logs every step through a [`Recorder`], and continues a killed session
-//! from its log (see [`hil_core::record`] for the format and the
+//! from its log (see [`hil_record`] for the format and the
 //! guarantees).
 
 use std::collections::VecDeque;
 
 use hil_core::metrics::EpisodeMetrics;
-use hil_core::record::{LoggedRecord, LoggedSession, Record, RecordLog, Recorder, ReplayChannel};
 use hil_core::{HilError, Result, Session, SessionObserver};
+use hil_record::{LoggedRecord, LoggedSession, Record, RecordLog, Recorder, ReplayChannel};
 
 use crate::experiment::{Experiment, ExperimentSummary};
 
@@ -23,7 +23,7 @@ use crate::experiment::{Experiment, ExperimentSummary};
 /// are given back in order, so no person is asked twice.
 struct ResumePlan {
     expected: Vec<LoggedRecord>,
-    answers: VecDeque<hil_core::record::LoggedAnswer>,
+    answers: VecDeque<hil_record::LoggedAnswer>,
 }
 
 fn plan(session: &LoggedSession, log: &RecordLog) -> Result<ResumePlan> {
@@ -65,7 +65,7 @@ fn plan(session: &LoggedSession, log: &RecordLog) -> Result<ResumePlan> {
 /// instead. `on_episode` is called with each episode's number and metrics,
 /// including episodes restored from the log.
 ///
-/// See [`hil_core::record`] for the guarantees.
+/// See [`hil_record`] for the guarantees.
 pub fn run_recorded(
     exp: &mut Experiment,
     log: RecordLog,

@@ -46,8 +46,8 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use hil_core::record::{Header, LoggedSession, RecordKey, RecordLog};
 use hil_core::{EpisodeMetrics, HilError, Result, SessionObserver, StepEvent};
+use hil_record::{Header, LoggedSession, RecordKey, RecordLog};
 
 use crate::{Experiment, ExperimentSummary, run_recorded};
 

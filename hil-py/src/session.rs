@@ -7,10 +7,10 @@
 
 use std::path::PathBuf;
 
-use hil_core::record::Header;
 use hil_core::{EventCollector, HilError, SessionObserver, SessionSettings};
 use hil_experiments::run::{Recording, Run, run_with};
 use hil_experiments::{Experiment, ExperimentSummary};
+use hil_record::Header;
 use pyo3::prelude::*;
 
 use crate::components::{channel_arg, environment_arg, policy_arg, workload_arg};

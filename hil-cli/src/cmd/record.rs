@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use hil_core::record::{RecordKey, RecordLog};
+use hil_record::{RecordKey, RecordLog};
 
 use crate::out::outln;
 

@@ -111,7 +111,7 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
     let key = args
         .record_key
         .as_deref()
-        .map(hil_core::record::RecordKey::read)
+        .map(hil_record::RecordKey::read)
         .transpose()?;
     let run = match &start {
         Start::Fresh { config, log } => Run::from_config_with_key(config, log.as_deref(), key)?,

@@ -169,7 +169,7 @@ fn a_second_writer_is_refused_naming_the_first() {
     assert!(err.contains("input ended"), "the log was free again: {err}");
 
     // A writer in this process (a library user) is named the same way.
-    let (held, _) = hil_core::record::RecordLog::open(&log).unwrap();
+    let (held, _) = hil_record::RecordLog::open(&log).unwrap();
     let out = hil().args(["run", "--resume"]).arg(&log).output().unwrap();
     assert!(!out.status.success());
     let err = stderr_of(&out);

@@ -10,11 +10,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::channel::PerfectExpert;
-use hil_core::record::{Header, RecordLog, Recorder};
 use hil_core::{
     ActionSpace, ArmId, Choice, Decision, Episode, EpisodeReport, EventCollector, HilError, Policy,
     Session, SessionObserver, SessionSettings,
 };
+use hil_record::{Header, RecordLog, Recorder};
 
 use crate::choices::{act, query};
 

@@ -6,13 +6,13 @@ use std::sync::{Arc, Mutex};
 
 use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::channel::PerfectExpert;
-use hil_core::record::{Header, Record, RecordLog};
 use hil_core::{
     ActionSpace, Answer, ArmId, Choice, HilError, Query, QueryChannel, QueryKind, Response,
     ResponseType, SessionSettings,
 };
 use hil_experiments::Experiment;
 use hil_experiments::run_recorded;
+use hil_record::{Header, Record, RecordLog};
 
 use crate::demo::lines_without_markers;
 
@@ -332,8 +332,8 @@ fn a_header_from_another_log_or_an_edited_config_is_refused() {
     lines[0] = lines[0].replacen("episodes = 3", "episodes = 4", 1);
     assert_refused(&path, &lines, 1, "config_digest");
     // ...and with the digest edited to match, the chain does not.
-    let new_digest = hil_core::record::chain::digest_hex("seed = 42\nepisodes = 4\n");
-    let old_digest = hil_core::record::chain::digest_hex("seed = 42\nepisodes = 3\n");
+    let new_digest = hil_record::chain::digest_hex("seed = 42\nepisodes = 4\n");
+    let old_digest = hil_record::chain::digest_hex("seed = 42\nepisodes = 3\n");
     lines[0] = lines[0].replacen(&old_digest, &new_digest, 1);
     assert_refused(&path, &lines, 1, "chain");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -344,7 +344,7 @@ fn a_log_has_one_writer_and_the_second_is_told_who_holds_it() {
     let dir = tmp_dir("lock");
     let path = dir.join("log.jsonl");
     let first = RecordLog::create(&path, header()).unwrap();
-    let owner = hil_core::record::lock::owner_path(&path);
+    let owner = hil_record::lock::owner_path(&path);
     assert!(owner.is_file());
     for _ in 0..2 {
         match RecordLog::open(&path).unwrap_err() {
@@ -441,8 +441,8 @@ fn a_finished_log_resumes_to_the_same_summary_without_running_anything() {
 
 #[test]
 fn a_step_that_cannot_be_logged_stops_the_session_before_the_robot_acts() {
-    use hil_core::record::Recorder;
     use hil_core::{ArmDiagnostics, Diagnostics, PendingStep, SessionObserver, StepDecision};
+    use hil_record::Recorder;
     let dir = tmp_dir("nan");
     let path = dir.join("log.jsonl");
     let mut rec = Recorder::new(RecordLog::create(&path, header()).unwrap());
@@ -478,11 +478,11 @@ fn a_log_of_the_previous_format_version_is_refused_and_says_why() {
     let path = dir.join("log.jsonl");
     full_run(&path);
     let text = std::fs::read_to_string(&path).unwrap();
-    let current = format!(r#""version":{}"#, hil_core::record::FORMAT_VERSION);
+    let current = format!(r#""version":{}"#, hil_record::FORMAT_VERSION);
     assert!(text.contains(&current));
     // Every older version (and a newer one) is refused before anything
     // else in the log is read, saying which version it is.
-    for v in (1..hil_core::record::FORMAT_VERSION).chain([99]) {
+    for v in (1..hil_record::FORMAT_VERSION).chain([99]) {
         let old = format!(r#""version":{v}"#);
         std::fs::write(&path, text.replacen(&current, &old, 1)).unwrap();
         match RecordLog::open(&path).unwrap_err() {

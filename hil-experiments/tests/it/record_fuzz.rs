@@ -14,10 +14,10 @@ use proptest::prelude::*;
 
 use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::channel::PerfectExpert;
-use hil_core::record::{Header, RecordLog};
 use hil_core::{ActionSpace, ArmId, Choice, HilError, QueryKind, SessionSettings};
 use hil_experiments::Experiment;
 use hil_experiments::run_recorded;
+use hil_record::{Header, RecordLog};
 
 fn dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();

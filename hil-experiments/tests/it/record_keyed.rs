@@ -7,9 +7,9 @@
 use std::path::{Path, PathBuf};
 
 use hil_core::HilError;
-use hil_core::record::chain::{self, Chain};
-use hil_core::record::{Header, RecordKey, RecordLog};
 use hil_experiments::run::Run;
+use hil_record::chain::{self, Chain};
+use hil_record::{Header, RecordKey, RecordLog};
 
 use crate::demo::{DemoSession, lines_without_markers, scratch_dir};
 

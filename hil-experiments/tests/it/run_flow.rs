@@ -121,7 +121,7 @@ fn a_missing_config_is_an_error_naming_it() {
 /// `lines` with `edit` applied to each record's JSON text, re-chained as
 /// a forger who knows the format would (the chain has no key).
 fn forge(lines: &[String], mut edit: impl FnMut(usize, String) -> String) -> String {
-    use hil_core::record::chain::{Chain, split};
+    use hil_record::chain::{Chain, split};
     let mut chain = Chain::start();
     let mut out = String::new();
     for (i, line) in lines.iter().enumerate() {
@@ -173,7 +173,7 @@ fn a_forged_summary_or_header_is_refused_on_resume() {
     }
 
     let header = dir.join("header.jsonl");
-    let digest = |cfg: &str| hil_core::record::chain::digest_hex(cfg);
+    let digest = |cfg: &str| hil_record::chain::digest_hex(cfg);
     let original = config_text();
     let changed = original.replace("n_att = 3", "n_att = 4");
     std::fs::write(

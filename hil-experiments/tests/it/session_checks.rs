@@ -7,13 +7,13 @@ use std::sync::Arc;
 
 use hil_conformance::fixtures::{CountingWorkload, ScriptedPolicy, TableEnv};
 use hil_core::channel::PerfectExpert;
-use hil_core::record::{Header, RecordLog};
 use hil_core::{
     ActionSpace, ArmId, Choice, Decision, DecisionInput, Diagnostics, Feedback, HilError, Policy,
     Query, QueryChannel, QueryKind, Response, SessionSettings, WorkloadModel,
 };
 use hil_experiments::Experiment;
 use hil_experiments::run_recorded;
+use hil_record::{Header, RecordLog};
 
 /// Decides like `ScriptedPolicy` but reports a NaN gap.
 struct NanDiagnostics(ScriptedPolicy);

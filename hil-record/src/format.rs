@@ -5,10 +5,10 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use crate::decision::Outcome;
-use crate::metrics::EpisodeMetrics;
-use crate::session::PendingStep;
-use crate::time::Timestep;
+use hil_core::decision::Outcome;
+use hil_core::metrics::EpisodeMetrics;
+use hil_core::session::PendingStep;
+use hil_core::time::Timestep;
 
 /// The `format` field of every log header.
 pub const FORMAT_NAME: &str = "hil-interaction-record";
@@ -115,7 +115,7 @@ pub enum Record {
         /// Its metrics.
         metrics: EpisodeMetrics,
     },
-    /// The policy's state after episode `episode` ([`crate::Policy::save`]).
+    /// The policy's state after episode `episode` ([`hil_core::Policy::save`]).
     Checkpoint {
         /// Episode number.
         episode: usize,

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 
-use crate::error::{HilError, Result};
+use hil_core::error::{HilError, Result};
 
 /// The fewest key bytes accepted (HMAC-SHA256's block of security).
 pub const MIN_BYTES: usize = 32;
@@ -56,7 +56,7 @@ impl RecordKey {
             field: field.into(),
             why,
         };
-        let text = crate::secrets::read_private(path, FILE_LIMIT)?;
+        let text = hil_core::secrets::read_private(path, FILE_LIMIT)?;
         let bytes =
             super::chain::from_hex(text.trim_end_matches(['\n', '\r'])).ok_or_else(|| {
                 err(
@@ -89,7 +89,7 @@ impl RecordKey {
         rand::rngs::OsRng.try_fill_bytes(&mut bytes).map_err(|e| {
             HilError::io("drawing random bytes for", path, std::io::Error::other(e))
         })?;
-        crate::secrets::create_private(
+        hil_core::secrets::create_private(
             path,
             format!("{}\n", super::chain::hex(&bytes)).as_bytes(),
         )?;
@@ -184,7 +184,7 @@ mod tests {
             .enumerate()
         {
             let path = d.join(format!("k{i}"));
-            crate::secrets::create_private(&path, text.as_bytes()).unwrap();
+            hil_core::secrets::create_private(&path, text.as_bytes()).unwrap();
             match RecordKey::read(&path) {
                 Err(HilError::Data { field, .. }) => assert_eq!(field, "key", "{text:?}"),
                 other => panic!("{text:?}: {other:?}"),

@@ -3,11 +3,11 @@
 
 use std::collections::VecDeque;
 
-use crate::error::{HilError, Result};
-use crate::metrics::EpisodeMetrics;
-use crate::record::format::Record;
-use crate::record::log::{LoggedRecord, RecordLog};
-use crate::session::{PendingStep, SessionObserver, StepEvent};
+use crate::format::Record;
+use crate::log::{LoggedRecord, RecordLog};
+use hil_core::error::{HilError, Result};
+use hil_core::metrics::EpisodeMetrics;
+use hil_core::session::{PendingStep, SessionObserver, StepEvent};
 
 /// Writes every session event to a [`RecordLog`]. Steps are on disk before
 /// the robot acts ([`SessionObserver::before_execute`]), outcomes as soon as

@@ -13,8 +13,8 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{HilError, Result};
-use crate::files::{limits, read_text};
+use hil_core::error::{HilError, Result};
+use hil_core::files::{limits, read_text};
 
 /// Who holds a log: written to its owner file by the writer.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -15,7 +15,7 @@
 //! | `step` | decided, **fsync'ed before the robot acts** | `episode`, `step`: `t`, `item_index`, `item_label`, `attempt`, `context`, `decision` (`act` / `query` with its `kind` = response type, difficulty, distraction, and `fallback` / `follow_expert`), `diagnostics`, `response` (answer, expert arm, response time; a `timed_out` answer means the policy acted on its own), `arm`, `wl_t` (WL_t = f(WL_0, Q_t) at this step) |
 //! | `outcome` | after execution, fsync'ed | `episode`, `t`, `outcome` (`success`, `success_probability`) |
 //! | `episode_end` | episode ends | `episode`, `metrics` |
-//! | `checkpoint` | after `episode_end`, if the policy can save its state | `episode`, `policy` (its [`crate::Policy::save`]) |
+//! | `checkpoint` | after `episode_end`, if the policy can save its state | `episode`, `policy` (its [`hil_core::Policy::save`]) |
 //! | `resumed` | where a resumed session started appending | `lines`, `truncated_bytes`, `from_checkpoint` (always null now: every resume replays from the start) |
 //!
 //! # One writer, and tamper evidence
@@ -25,7 +25,7 @@
 //! a resume while the original run still writes, is refused with an error
 //! naming the process, host and start time of the holder.
 //!
-//! [`RecordLog::open`] reads at most [`crate::files::limits::LOG`] bytes of
+//! [`RecordLog::open`] reads at most [`hil_core::files::limits::LOG`] bytes of
 //! a regular file and verifies every complete line before anything is
 //! resumed: its record, its place in the hash chain, and the header's
 //! `config_digest`. A flipped bit anywhere (an `episode_end` before the
@@ -71,7 +71,7 @@
 //! not exist yet.
 //!
 //! ```
-//! use hil_core::record::{Header, RecordLog, Recorder, Record};
+//! use hil_record::{Header, RecordLog, Recorder, Record};
 //! let dir = std::env::temp_dir().join(format!("hil-record-doc-{}", std::process::id()));
 //! std::fs::create_dir_all(&dir).unwrap();
 //! let path = dir.join("session.jsonl");
@@ -96,7 +96,7 @@ pub mod log;
 pub mod recorder;
 pub mod replay;
 
-use crate::event::StepEvent;
+use hil_core::event::StepEvent;
 
 pub use format::{FORMAT_NAME, FORMAT_VERSION, Header, Record};
 pub use key::RecordKey;

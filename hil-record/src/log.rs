@@ -8,12 +8,12 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use crate::error::{HilError, Result};
-use crate::files::{limits, read_bytes};
-use crate::record::chain::{self, Chain};
-use crate::record::format::{FORMAT_NAME, FORMAT_VERSION, Header, Record};
-use crate::record::key::RecordKey;
-use crate::record::lock;
+use crate::chain::{self, Chain};
+use crate::format::{FORMAT_NAME, FORMAT_VERSION, Header, Record};
+use crate::key::RecordKey;
+use crate::lock;
+use hil_core::error::{HilError, Result};
+use hil_core::files::{limits, read_bytes};
 
 /// An append-only JSONL file whose every line reaches the disk (fsync)
 /// before [`RecordLog::append`] returns.

@@ -9,9 +9,9 @@
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use hil_core::record::chain::Chain;
-use hil_core::record::{Header, Record, RecordLog, Recorder};
 use hil_core::{ArmId, Context, Outcome, PendingStep, SessionObserver, StepDecision, StepEvent};
+use hil_record::chain::Chain;
+use hil_record::{Header, Record, RecordLog, Recorder};
 
 fn dir() -> PathBuf {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

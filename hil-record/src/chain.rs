@@ -21,7 +21,7 @@
 //! have been.
 //!
 //! ```
-//! use hil_core::record::chain::{Chain, split};
+//! use hil_record::chain::{Chain, split};
 //! let mut chain = Chain::start();
 //! let line = chain.seal(r#"{"record":"episode_start","episode":0,"seed":1}"#, true);
 //! let (digest, content) = split(&line).unwrap();

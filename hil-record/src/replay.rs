@@ -3,10 +3,10 @@
 use std::collections::VecDeque;
 use std::path::PathBuf;
 
-use crate::channel::QueryChannel;
-use crate::error::{HilError, Result};
-use crate::query::{Query, Response};
-use crate::time::Timestep;
+use hil_core::channel::QueryChannel;
+use hil_core::error::{HilError, Result};
+use hil_core::query::{Query, Response};
+use hil_core::time::Timestep;
 
 /// A logged answer: episode, timestep, the response and its log line.
 pub type LoggedAnswer = (usize, Timestep, Response, usize);

@@ -1,7 +1,7 @@
 //! Secret files: readable and writable by their owner only. What a server
 //! keeps in its data folder between runs (hil-http: a study's researcher
 //! token, a self-signed certificate's private key) and the key of a keyed
-//! interaction log ([`crate::record::key`]).
+//! interaction log (`hil_record::RecordKey`).
 //!
 //! As ssh does with private keys, a secret that other users may read or
 //! write is refused rather than used: whoever can read it can act with it.

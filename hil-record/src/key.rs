@@ -100,7 +100,7 @@ impl RecordKey {
     }
 
     /// The key's fingerprint, as a log's header records it: the first
-    /// [`ID_HEX`] hex digits of a SHA-256 over a fixed label and the key.
+    /// 16 hex digits of a SHA-256 over a fixed label and the key.
     pub fn id(&self) -> String {
         let mut h = Sha256::new();
         h.update(b"hil-record-key-id\0");

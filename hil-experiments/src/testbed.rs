@@ -296,6 +296,14 @@ impl ProtocolSettings {
         }
         s.check_components()
             .map_err(|e| hil_config::error_in_section(&text, path, &[], e))?;
+        // The split's foods against the dataset it names, here where the
+        // text is at hand, so an unknown food names its line.
+        let ds = s
+            .load_dataset()
+            .map_err(|e| hil_config::error_at_key(&text, path, &["dataset"], e.to_string()))?;
+        s.split
+            .validate(&ds)
+            .map_err(|e| hil_config::error_in_section(&text, path, &[], e))?;
         for m in &mut s.models {
             if let Some(f) = &mut m.file {
                 *f = base.join(&*f);

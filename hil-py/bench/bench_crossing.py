@@ -24,6 +24,9 @@ Run (release build)::
 
     maturin develop --release --manifest-path hil-py/Cargo.toml
     python hil-py/bench/bench_crossing.py --repeats 5
+
+``--write-doc FILE`` also keeps the report as a results page naming the
+command (docs/results/python-crossing-bench.md).
 """
 
 from __future__ import annotations
@@ -40,7 +43,10 @@ from typing import Callable, Optional
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import results_page  # noqa: E402
 from bench_linucb import ARMS, Workload, mean_se  # noqa: E402
+
+PAGE_TITLE = "Crossing from Python into hil, warm and cold caches"
 
 
 def noop2(x, t):
@@ -103,7 +109,11 @@ def main(argv: Optional[list[str]] = None) -> dict:
     ap.add_argument("--dim", type=int, default=16)
     ap.add_argument("--evict-mb", type=float, default=30.0)
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--write-doc", metavar="FILE",
+                    help="also keep the printed report as a Markdown results page at FILE")
     args = ap.parse_args(argv)
+    if args.json and args.write_doc:
+        ap.error("--write-doc keeps the text report; it cannot be combined with --json")
     big = np.ones(max(1, int(args.evict_mb * 2**20 / 8)))
     result: dict = {"dim": args.dim, "evict_mb": args.evict_mb, "repeats": args.repeats,
                     "steps": args.steps, "load_average_1m": os.getloadavg()[0], "data": "synthetic",
@@ -117,11 +127,14 @@ def main(argv: Optional[list[str]] = None) -> dict:
     if args.json:
         print(json.dumps(result))
     else:
-        print(f"d = {args.dim}; two calls per step; median over {args.steps} steps, mean +- SE over "
-              f"{args.repeats} repeats (synthetic data)")
+        lines = [f"d = {args.dim}; two calls per step; median over {args.steps} steps, mean +- SE "
+                 f"over {args.repeats} repeats (synthetic data); 1-minute load average "
+                 f"{result['load_average_1m']:.1f} at the start"]
         for label, rows in result["us_per_step"].items():
             cells = ", ".join(f"{k} {m:.2f} +- {se:.2f} us" for k, (m, se) in rows.items())
-            print(f"  {label:8s} {cells}")
+            lines.append(f"  {label:8s} {cells}")
+        report = "\n".join(lines) + "\n"
+        results_page.emit(report, args.write_doc, PAGE_TITLE, __file__, argv)
     return result
 
 

@@ -29,11 +29,16 @@ Run (release build of hil, bench packages installed)::
     pip install -r hil-py/bench/requirements.txt
     maturin develop --release --manifest-path hil-py/Cargo.toml
     python hil-py/bench/bench_linucb.py --repeats 5
+
+A library that is not installed is skipped, and the report says so.
+``--write-doc FILE`` also keeps the report as a results page naming the
+command (docs/results/python-linucb-bench.md).
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import math
 import os
@@ -44,7 +49,13 @@ from typing import Callable, Optional
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import results_page  # noqa: E402  (the sibling module, also when loaded by path)
+
 D, ARMS, PER_ARM, ALPHA = 2048, 6, 300, 0.5
+# The libraries of requirements.txt: skipped (and reported) when missing.
+OPTIONAL_LIBS = ("mabwiser", "contextualbandits")
+PAGE_TITLE = "LinUCB from Python: hil, NumPy, contextualbandits, MABWiser"
 
 
 class Workload:
@@ -186,6 +197,26 @@ def mean_se(xs: list[float]) -> tuple[float, float]:
     return m, se
 
 
+def text_report(args: argparse.Namespace, result: dict, libs: list[str]) -> str:
+    """The printed report (and the results page's text block)."""
+    lines = [f"d = {args.dim}, {ARMS} arms, {args.per_arm} pretraining observations per arm, "
+             f"{args.repeats} repeats (mean +- SE over repeats; synthetic data), "
+             f"1-minute load average {result['load_average_1m']:.1f} at the end"]
+    for lib in libs:
+        m, se = result["us_per_step"][lib]
+        md, mdse = result["median_us_per_step"][lib]
+        lines.append(f"  {lib:18s} mean {m:12.1f} +- {se:8.1f} us, "
+                     f"median {md:12.1f} +- {mdse:8.1f} us"
+                     f" per decide + observe ({result['steps_per_repeat'][lib]} steps per repeat)")
+    if "hil_crossing_us_per_step" in result:
+        m, se = result["hil_crossing_us_per_step"]
+        lines.append(f"  hil crossing from Python: {m:.2f} +- {se:.2f} us per step "
+                     "(decide + observe)")
+    if result["skipped_not_installed"]:
+        lines.append("  not installed, so not run: " + ", ".join(result["skipped_not_installed"]))
+    return "\n".join(lines) + "\n"
+
+
 def main(argv: Optional[list[str]] = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=200, help="timed steps (fast libraries)")
@@ -196,7 +227,11 @@ def main(argv: Optional[list[str]] = None) -> dict:
     ap.add_argument("--dim", type=int, default=D, help="context dimension (tests use a small one)")
     ap.add_argument("--per-arm", type=int, default=PER_ARM)
     ap.add_argument("--json", action="store_true", help="print one JSON object")
+    ap.add_argument("--write-doc", metavar="FILE",
+                    help="also keep the printed report as a Markdown results page at FILE")
     args = ap.parse_args(argv)
+    if args.json and args.write_doc:
+        ap.error("--write-doc keeps the text report; it cannot be combined with --json")
     policy = {"type": "linucb_qg", "alpha": ALPHA, "w": 0.2, "pretrain": True}
     makers = {
         "hil": lambda w: make_hil(w, dict(policy)),
@@ -204,7 +239,15 @@ def main(argv: Optional[list[str]] = None) -> dict:
         "contextualbandits": make_contextualbandits,
         "mabwiser": make_mabwiser,
     }
-    libs = [s for s in args.libs.split(",") if s]
+    asked = [s for s in args.libs.split(",") if s]
+    unknown = [lib for lib in asked if lib not in makers]
+    if unknown:
+        ap.error(f"unknown --libs {', '.join(unknown)} (known: {', '.join(makers)})")
+    # hil and numpy are this package's own dependencies; the others are
+    # optional (requirements.txt), so a missing one is skipped and reported.
+    skipped = [lib for lib in asked
+               if lib in OPTIONAL_LIBS and importlib.util.find_spec(lib) is None]
+    libs = [lib for lib in asked if lib not in skipped]
     per_repeat: dict[str, list[float]] = {lib: [] for lib in libs}
     medians: dict[str, list[float]] = {lib: [] for lib in libs}
     overhead: list[float] = []
@@ -237,22 +280,15 @@ def main(argv: Optional[list[str]] = None) -> dict:
         "median_us_per_step": {lib: [v * 1e6 for v in mean_se(medians[lib])] for lib in libs},
         "steps_per_repeat": steps_used,
         "data": "synthetic",
+        "skipped_not_installed": skipped,
     }
     if overhead:
         result["hil_crossing_us_per_step"] = [v * 1e6 for v in mean_se(overhead)]
     if args.json:
         print(json.dumps(result))
     else:
-        print(f"d = {args.dim}, {ARMS} arms, {args.per_arm} pretraining observations per arm, "
-              f"{args.repeats} repeats (mean +- SE over repeats; synthetic data)")
-        for lib in libs:
-            m, se = result["us_per_step"][lib]
-            md, mdse = result["median_us_per_step"][lib]
-            print(f"  {lib:18s} mean {m:12.1f} +- {se:8.1f} us, median {md:12.1f} +- {mdse:8.1f} us"
-                  f" per decide + observe ({steps_used[lib]} steps per repeat)")
-        if overhead:
-            m, se = result["hil_crossing_us_per_step"]
-            print(f"  hil crossing from Python: {m:.2f} +- {se:.2f} us per step (decide + observe)")
+        report = text_report(args, result, libs)
+        results_page.emit(report, args.write_doc, PAGE_TITLE, __file__, argv)
     return result
 
 

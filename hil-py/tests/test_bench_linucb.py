@@ -5,6 +5,7 @@ reference agrees with hil's LinUCB on the arm it picks; it times nothing
 (speed is measured by running the benchmark, see hil-py/README.md).
 """
 
+import importlib.util
 import json
 
 import numpy as np
@@ -39,3 +40,31 @@ def test_numpy_reference_picks_the_same_arms_as_hils_linucb():
         observe(x, arm, r, t, False)
         ref.observe(x, arm, r)
     assert np.isfinite(ref.a_inv).all()
+
+
+def test_write_doc_keeps_the_printed_report_as_a_results_page(capsys, tmp_path):
+    page = tmp_path / "results" / "bench.md"
+    argv = ["--libs", "hil,numpy,mabwiser,contextualbandits", "--dim", "8", "--per-arm", "3",
+            "--steps", "3", "--repeats", "2", "--write-doc", str(page)]
+    load_bench().main(argv)
+    report = capsys.readouterr().out
+    assert "hil crossing from Python" in report
+    md = page.read_text(encoding="utf-8")
+    assert md.startswith("<!-- Written by `python hil-py/bench/bench_linucb.py --libs")
+    assert f"```text\n{report}```\n" in md
+    assert "```sh\npython hil-py/bench/bench_linucb.py" in md
+    # An optional library that is not installed is named, not silently dropped.
+    for lib in ("mabwiser", "contextualbandits"):
+        if importlib.util.find_spec(lib) is None:
+            assert "not installed, so not run: " in report and lib in report
+        else:
+            assert f"  {lib} " in report
+
+
+def test_results_page_has_the_format_of_the_rust_results_page():
+    # The same page `hil_experiments::results_page::ResultsPage::to_markdown` writes.
+    page = load_script("bench/results_page.py")
+    assert page.to_markdown("T", "python x.py --a 1", "r 1 +- 2\n") == (
+        "<!-- Written by `python x.py --a 1`: do not edit by hand, rerun the command. -->\n"
+        "# T\n\nWritten by the command below; rerun it to refresh this page.\n\n"
+        "```sh\npython x.py --a 1\n```\n\n```text\nr 1 +- 2\n```\n")

@@ -53,6 +53,11 @@ enum WorkloadCommand {
         /// print the calibrated parameters.
         #[arg(long)]
         centre: bool,
+        /// Also keep the printed report as a Markdown results page at this
+        /// path (e.g. docs/results/workload-generator-seeds.md), naming this
+        /// command line.
+        #[arg(long, value_name = "FILE")]
+        write_doc: Option<PathBuf>,
     },
     /// Print a study's headline figures (pairs, WL mean ± sd, Mann-Whitney D1 < D2).
     Summary {
@@ -159,6 +164,9 @@ impl CvArgs {
 }
 
 const SYNTHETIC: &str = SYNTHETIC_DATA_NOTE;
+
+/// Heading of the results page `hil workload seeds --write-doc` writes.
+const SEEDS_TITLE: &str = "Workload generator over seeds";
 
 /// Runs `hil workload`.
 pub fn run(args: WorkloadArgs) -> Result<()> {
@@ -295,29 +303,29 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             count,
             config,
             centre,
+            write_doc,
         } => {
             let cfg = synth_config(config.as_deref())?;
             let t0 = Instant::now();
-            if centre {
+            let mut report = if centre {
                 let (c, spread) = hil_workload::seeds::centre(&cfg, 0..count, 0.002, 8)?;
-                out!("{}", spread.to_text())?;
                 let p = &c.params;
-                outln!(
-                    "calibrated: mean = {}, population_shift = {}, participant_sd = {}, limited_survey_sd = {}",
+                format!(
+                    "{}calibrated: mean = {}, population_shift = {}, participant_sd = {}, limited_survey_sd = {}\n",
+                    spread.to_text(),
                     p.mean,
                     p.population_shift,
                     p.participant_sd,
                     p.limited_survey_sd
-                )?;
+                )
             } else {
-                out!(
-                    "{}",
-                    hil_workload::seeds::SeedSpread::over(&cfg, 0..count)?.to_text()
-                )?;
-            }
-            use std::io::Write as _;
-            let _ = std::io::stdout().flush();
-            note!("{:.1} s. {SYNTHETIC}", t0.elapsed().as_secs_f64());
+                hil_workload::seeds::SeedSpread::over(&cfg, 0..count)?.to_text()
+            };
+            // The note belongs to the report, so a results page carries it too.
+            report.push_str(SYNTHETIC);
+            report.push('\n');
+            super::emit_report(&report, write_doc.as_deref(), SEEDS_TITLE)?;
+            note!("{:.1} s.", t0.elapsed().as_secs_f64());
             Ok(())
         }
         WorkloadCommand::Calibrate { dir, check } => {

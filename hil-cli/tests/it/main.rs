@@ -24,3 +24,4 @@ mod terminal_pty;
 mod web_run;
 #[cfg(not(feature = "physics"))]
 mod without_physics;
+mod workload_seeds;

@@ -39,8 +39,6 @@ impl Threads {
 /// This run's command line as a person would type it (`hil` and the
 /// arguments, shell-quoted where needed), for results pages to name the
 /// command that wrote them.
-// Only the physics and speech commands keep results pages.
-#[cfg_attr(not(any(feature = "physics", feature = "speech")), allow(dead_code))]
 pub fn command_line() -> String {
     let quote = |a: String| {
         let plain = !a.is_empty()
@@ -65,8 +63,6 @@ pub fn command_line() -> String {
 /// Prints a report and, with `--write-doc FILE`, keeps it as a results
 /// page ([`hil_experiments::results_page`]) naming this command line, so
 /// that a figure a README cites comes from the command that measured it.
-// Only the physics and speech commands keep results pages.
-#[cfg_attr(not(any(feature = "physics", feature = "speech")), allow(dead_code))]
 pub fn emit_report(report: &str, write_doc: Option<&Path>, title: &str) -> hil_core::Result<()> {
     crate::out::out!("{report}")?;
     if let Some(path) = write_doc {

@@ -79,6 +79,11 @@ pub struct PolicyArgs {
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
+    /// Also keep the printed summary as a Markdown results page at this
+    /// path (e.g. docs/results/policy-bench-fresh.md), naming this command
+    /// line.
+    #[arg(long, value_name = "FILE", conflicts_with = "json")]
+    write_doc: Option<PathBuf>,
 }
 
 pub fn run(a: PolicyArgs) -> Result<()> {
@@ -103,9 +108,11 @@ pub fn run(a: PolicyArgs) -> Result<()> {
     };
     let report = bench.run()?;
     if a.json {
-        outln!("{}", report.to_json(&bench))?;
-    } else {
-        outln!("{}", report.summary(&bench))?;
+        return outln!("{}", report.to_json(&bench));
     }
-    Ok(())
+    crate::cmd::emit_report(
+        &format!("{}\n", report.summary(&bench)),
+        a.write_doc.as_deref(),
+        "A policy's decide + observe against the memory-bandwidth floor",
+    )
 }

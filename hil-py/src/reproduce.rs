@@ -19,7 +19,8 @@ use crate::errors::{IntoPy, to_py_err};
 
 /// The protocol settings a `settings` argument names: None (the paper's,
 /// or the quick preset with `quick`), a settings file path, or a dict whose
-/// keys replace the preset's.
+/// keys replace the preset's (a dict that replaces `methods` drops the
+/// preset's `grid_variants` unless it gives its own).
 fn settings_of(settings: Option<&Bound<'_, PyAny>>, quick: bool) -> PyResult<ProtocolSettings> {
     let preset = if quick {
         ProtocolSettings::quick()
@@ -35,6 +36,12 @@ fn settings_of(settings: Option<&Bound<'_, PyAny>>, quick: bool) -> PyResult<Pro
             .py_err()?;
         let over: Value = from_py(d.as_any(), "protocol settings")?;
         if let (Some(b), Value::Object(o)) = (base.as_object_mut(), over) {
+            // The preset's grid variants retune the preset's methods by
+            // label: a dict that replaces the methods and names no variants
+            // of its own runs its methods' own grids only.
+            if o.contains_key("methods") && !o.contains_key("grid_variants") {
+                b.remove("grid_variants");
+            }
             b.extend(o);
         }
         let s: ProtocolSettings = serde_json::from_value(base)

@@ -21,6 +21,8 @@ def small_quick():
     s.update(many_seeds=0, n_policy_seeds=1, w_tasks=[0.4, 0.7], cross=[])
     s["models"] = [m for m in s["models"] if m["name"] == "f2_sim"]
     s["methods"] = [m for m in s["methods"] if m["label"] != "LinUCB-ExpDecay"]
+    # The preset's grid variants retune LinUCB-ExpDecay, dropped above.
+    s["grid_variants"] = []
     s["figures"].update(model="f2_sim", workload=["AlwaysQuery", "LinUCB-QG"])
     return s
 

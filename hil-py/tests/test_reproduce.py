@@ -18,7 +18,7 @@ SMALL = {
 
 def test_the_quick_preset_runs_every_paper_method():
     r = hil.reproduce(quick=True, many_seeds=0)
-    assert set(r) == {"paper_protocol", "many_seeds", "frontier"}
+    assert set(r) == {"paper_protocol", "many_seeds", "frontier", "grid_variants"}
     assert r["many_seeds"] is None
     text = json.dumps(r["paper_protocol"])
     for label in ["LinUCB", "AlwaysQuery", "LinUCB-ExpDecay", "LinUCB-QG"]:

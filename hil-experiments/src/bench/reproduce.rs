@@ -28,7 +28,7 @@ impl ReproduceBenchReport {
     /// The report as `hil bench reproduce` prints it.
     pub fn to_json(&self) -> serde_json::Value {
         json!({
-            "job": "hil reproduce (default: 3-seed protocol + 30-seed run, 6 workload models)",
+            "job": "hil reproduce (default: 3-seed protocol + 30-seed run, the calibrated workload models in three variants, the paper-implied and hil grids)",
             "episodes": self.episodes,
             "threads": self.threads,
             "runs": self.wall_s.len(),

@@ -127,22 +127,9 @@ fn unknown_policy_and_bad_settings_fail_clearly() {
 /// names the command line (the figures a README cites come from it).
 #[test]
 fn write_doc_keeps_the_printed_summary_and_the_command() {
-    let dir = std::env::temp_dir().join(format!("hil-bench-policy-doc-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let page = dir.join("policy.md");
     let mut args = vec!["bench", "policy"];
     args.extend_from_slice(&SMALL);
-    args.extend_from_slice(&["--write-doc", page.to_str().unwrap()]);
-    let out = hil(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let summary = String::from_utf8(out.stdout).unwrap();
+    let summary =
+        common::report_kept_as_page("bench-policy-doc", &args, "hil bench policy --dim 8");
     assert!(summary.contains("median decide+observe"), "{summary}");
-    let md = std::fs::read_to_string(&page).unwrap();
-    assert!(md.contains(&format!("```text\n{summary}```")), "{md}");
-    assert!(md.contains("hil bench policy --dim 8"), "{md}");
-    let _ = std::fs::remove_dir_all(&dir);
 }

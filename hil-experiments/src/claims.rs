@@ -35,6 +35,20 @@ impl Verdict {
     /// `a − b` should be positive (`expect_greater`) or negative.
     pub fn of(a: Stat, b: Stat, expect_greater: bool) -> Self {
         let (d, se) = difference(a, b);
+        Self::of_difference(d, se, expect_greater)
+    }
+
+    /// A difference `d` with standard error `se` (however it was
+    /// estimated, e.g. paired over seeds) should be positive
+    /// (`expect_greater`) or negative.
+    ///
+    /// ```
+    /// use hil_experiments::claims::Verdict;
+    /// assert_eq!(Verdict::of_difference(0.3, 0.1, true), Verdict::Holds);
+    /// assert_eq!(Verdict::of_difference(0.1, 0.1, true), Verdict::NotResolved);
+    /// assert_eq!(Verdict::of_difference(0.3, 0.1, false), Verdict::Opposite);
+    /// ```
+    pub fn of_difference(d: f64, se: f64, expect_greater: bool) -> Self {
         let signed = if expect_greater { d } else { -d };
         if signed > 2.0 * se {
             Self::Holds

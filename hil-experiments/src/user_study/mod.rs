@@ -63,4 +63,7 @@ pub use run::{
     Episode, MethodSummary, Plate, PlateResult, Protocol, Selection, UserStudy, UserStudyResult,
     method_order,
 };
-pub use seeds::{ChosenAcrossSeeds, MethodAcrossSeeds, UserStudyOverSeeds, across_seeds};
+pub use seeds::{
+    ChosenAcrossSeeds, MethodAcrossSeeds, PairedDifference, UserStudyOverSeeds, across_seeds,
+    paired_differences,
+};

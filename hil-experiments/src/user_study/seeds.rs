@@ -13,6 +13,7 @@ use hil_stats::Stat;
 use serde::Serialize;
 
 use super::config::UserStudyConfig;
+use crate::claims::Verdict;
 use super::run::{MethodSummary, Protocol, Selection, UserStudyResult};
 
 /// One method over many seeds: each figure is the mean ± standard error
@@ -105,8 +106,101 @@ pub struct UserStudyOverSeeds {
     pub methods: Vec<MethodAcrossSeeds>,
     /// Every seed's selections of tuned hyperparameters, in seed order.
     pub selections: Vec<Vec<Selection>>,
+    /// Each pair of methods' r_task_avg, paired over seeds
+    /// ([`paired_differences`]).
+    pub differences: Vec<PairedDifference>,
     /// The first seed's protocol.
     pub protocol: Protocol,
+}
+
+/// One method's r_task_avg against another's, paired over seeds: every
+/// seed runs every method on the same foods and channel seeds, so the
+/// per-seed difference removes what the seeds share and its standard error
+/// is the one a "beats by more than 2 SE" reading needs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PairedDifference {
+    /// The method whose r_task_avg comes first in the difference.
+    pub method: String,
+    /// The method subtracted.
+    pub baseline: String,
+    /// `method − baseline` on each seed, as mean ± standard error over
+    /// the seeds that ran both.
+    #[serde(with = "hil_stats::summary::as_mean_sem")]
+    pub r_task_avg: Stat,
+    /// The paper's real-study difference, where it reports both methods.
+    pub paper: Option<f64>,
+    /// Against the paper's sign: `holds` (its sign by more than 2 SE),
+    /// `not resolved` or `opposite` ([`Verdict`]); `None` without paper
+    /// figures or with fewer than two seeds.
+    pub verdict: Option<&'static str>,
+}
+
+/// Every pair of methods of `runs` (in the first seed's order), each
+/// oriented so that the paper's higher method comes first (later minus
+/// earlier where the paper has no figures), with its r_task_avg
+/// difference paired over seeds.
+///
+/// ```
+/// use hil_experiments::user_study::{UserStudyConfig, paired_differences};
+/// let cfg = UserStudyConfig::parse(
+///     "repetitions = 1\n[environment]\ntype = \"food_replay\"\nfoods = [\"banana\"]\nitems_per_episode = 2\n[[methods]]\nlabel = \"LinUCB\"\npolicy = { type = \"linucb\", alpha = 0.5 }\n[[methods]]\nlabel = \"AlwaysQuery\"\npolicy = { type = \"always_query\", alpha = 0.5 }\n",
+///     "study.toml".as_ref(),
+/// )
+/// .unwrap();
+/// let runs: Vec<_> = [3, 4]
+///     .iter()
+///     .map(|&s| cfg.run_on_seed(".".as_ref(), s, |_| {}).unwrap())
+///     .collect();
+/// let d = paired_differences(&runs);
+/// // The paper's AlwaysQuery fed more than its LinUCB: it comes first.
+/// assert_eq!((d[0].method.as_str(), d[0].baseline.as_str()), ("AlwaysQuery", "LinUCB"));
+/// assert_eq!(d[0].r_task_avg.n, 2);
+/// ```
+pub fn paired_differences(runs: &[UserStudyResult]) -> Vec<PairedDifference> {
+    let Some(first) = runs.first() else {
+        return Vec::new();
+    };
+    let labels: Vec<&str> = first.methods.iter().map(|m| m.method.as_str()).collect();
+    let paper = |label: &str| {
+        PaperMethod::from_label(label)
+            .and_then(hil_paper::user_study::row)
+            .map(|p| p.r_task_avg.mean)
+    };
+    let mut out = Vec::new();
+    for (i, &earlier) in labels.iter().enumerate() {
+        for &later in &labels[i + 1..] {
+            let (a, b) = match (paper(earlier), paper(later)) {
+                (Some(pe), Some(pl)) if pe > pl => (earlier, later),
+                _ => (later, earlier),
+            };
+            out.push(paired(runs, a, b, paper(a).zip(paper(b)).map(|(pa, pb)| pa - pb)));
+        }
+    }
+    out
+}
+
+fn paired(runs: &[UserStudyResult], a: &str, b: &str, paper: Option<f64>) -> PairedDifference {
+    let r_task = |run: &UserStudyResult, label: &str| {
+        run.methods
+            .iter()
+            .find(|m| m.method == label)
+            .map(|m| m.r_task_avg)
+    };
+    let per_seed: Vec<f64> = runs
+        .iter()
+        .filter_map(|run| Some(r_task(run, a)? - r_task(run, b)?))
+        .collect();
+    let r_task_avg = Stat::of(&per_seed);
+    let verdict = paper.zip(r_task_avg.sem()).map(|(p, se)| {
+        Verdict::of_difference(r_task_avg.mean, se, p > 0.0).word()
+    });
+    PairedDifference {
+        method: a.to_string(),
+        baseline: b.to_string(),
+        r_task_avg,
+        paper,
+        verdict,
+    }
 }
 
 /// The value a tuned method's validation chose on each seed.
@@ -132,6 +226,7 @@ impl UserStudyOverSeeds {
         Ok(Self {
             seeds,
             methods: across_seeds(runs),
+            differences: paired_differences(runs),
             selections: runs.iter().map(|r| r.selections.clone()).collect(),
             protocol: first.protocol.clone(),
         })

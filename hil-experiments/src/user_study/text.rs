@@ -148,6 +148,24 @@ fn write_over_seeds(o: &mut String, over: &UserStudyOverSeeds) -> fmt::Result {
             pm(q.mean, q.sem(), 2)
         )?;
     }
+    if !over.differences.is_empty() {
+        writeln!(
+            o,
+            "r_task_avg differences, paired over seeds (mean ± standard error of each seed's difference); paper's in brackets, verdict against its sign by 2 SE"
+        )?;
+    }
+    for d in &over.differences {
+        let paper = d.paper.map_or(String::new(), |p| format!(" [{p:+.2}]"));
+        let r = d.r_task_avg;
+        let sign = if r.mean >= 0.0 { "+" } else { "" };
+        writeln!(
+            o,
+            "{:<26} {sign}{}{paper}{}",
+            format!("{} − {}", d.method, d.baseline),
+            pm(r.mean, r.sem(), 3),
+            d.verdict.map_or(String::new(), |v| format!("  {v}"))
+        )?;
+    }
     writeln!(
         o,
         "where each method asks: queries per plate at each food, and at each attempt index"

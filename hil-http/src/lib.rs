@@ -47,6 +47,7 @@ pub mod guard;
 pub mod page;
 pub mod parse;
 pub mod secrets;
+mod self_signed;
 mod server;
 mod slots;
 #[cfg(feature = "testing")]

@@ -3,7 +3,8 @@
 //! kept in the server's data folder, so its fingerprint, which the person
 //! checks once in the browser, stays the same.
 //!
-//! rustls with the `ring` provider; certificates made by `rcgen`.
+//! rustls with the `ring` provider; self-signed certificates written by
+//! [`crate::self_signed`].
 //!
 //! [`Server::start_tls`]: crate::Server::start_tls
 
@@ -177,16 +178,9 @@ impl Tls {
                 all.push(n.clone());
             }
         }
-        let made = (|| {
-            let mut params = rcgen::CertificateParams::new(all)?;
-            params
-                .distinguished_name
-                .push(rcgen::DnType::CommonName, "hil (self-signed)");
-            let key = rcgen::KeyPair::generate()?;
-            let cert = params.self_signed(&key)?;
-            Ok::<_, rcgen::Error>((cert.pem(), key.serialize_pem()))
-        })()
-        .map_err(|e| tls_error(&cert_path, format!("cannot make a certificate: {e}")))?;
+        let made = crate::self_signed::make(&all)
+            .map_err(|e| tls_error(&cert_path, format!("cannot make a certificate: {e}")))?;
+        let made = (made.cert_pem, made.key_pem);
         // The key first: a cut-short start leaves a key alone, which the
         // next start reports, never a certificate without its key.
         create_private(&key_path, made.1.as_bytes())?;

@@ -13,8 +13,8 @@ use hil_stats::Stat;
 use serde::Serialize;
 
 use super::config::UserStudyConfig;
-use crate::claims::Verdict;
 use super::run::{MethodSummary, Protocol, Selection, UserStudyResult};
+use crate::claims::Verdict;
 
 /// One method over many seeds: each figure is the mean ± standard error
 /// over seeds of each seed's mean per plate.
@@ -173,7 +173,12 @@ pub fn paired_differences(runs: &[UserStudyResult]) -> Vec<PairedDifference> {
                 (Some(pe), Some(pl)) if pe > pl => (earlier, later),
                 _ => (later, earlier),
             };
-            out.push(paired(runs, a, b, paper(a).zip(paper(b)).map(|(pa, pb)| pa - pb)));
+            out.push(paired(
+                runs,
+                a,
+                b,
+                paper(a).zip(paper(b)).map(|(pa, pb)| pa - pb),
+            ));
         }
     }
     out
@@ -191,9 +196,9 @@ fn paired(runs: &[UserStudyResult], a: &str, b: &str, paper: Option<f64>) -> Pai
         .filter_map(|run| Some(r_task(run, a)? - r_task(run, b)?))
         .collect();
     let r_task_avg = Stat::of(&per_seed);
-    let verdict = paper.zip(r_task_avg.sem()).map(|(p, se)| {
-        Verdict::of_difference(r_task_avg.mean, se, p > 0.0).word()
-    });
+    let verdict = paper
+        .zip(r_task_avg.sem())
+        .map(|(p, se)| Verdict::of_difference(r_task_avg.mean, se, p > 0.0).word());
     PairedDifference {
         method: a.to_string(),
         baseline: b.to_string(),

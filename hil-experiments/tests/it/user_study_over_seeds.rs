@@ -114,7 +114,10 @@ fn method_differences_are_paired_seed_by_seed_and_read_against_the_papers_sign()
     assert_eq!(over.differences.len(), 1);
     let d = &over.differences[0];
     // The paper's LinUCB-QG fed more than its LinUCB, so it comes first.
-    assert_eq!((d.method.as_str(), d.baseline.as_str()), ("LinUCB-QG", "LinUCB"));
+    assert_eq!(
+        (d.method.as_str(), d.baseline.as_str()),
+        ("LinUCB-QG", "LinUCB")
+    );
     let per_seed: Vec<f64> = singles
         .iter()
         .map(|s| s.methods[1].r_task_avg - s.methods[0].r_task_avg)
@@ -124,12 +127,9 @@ fn method_differences_are_paired_seed_by_seed_and_read_against_the_papers_sign()
     assert_eq!(d.r_task_avg, Stat::of(&per_seed));
     let paper = d.paper.unwrap();
     assert!(paper > 0.0, "{paper}");
-    let expected = hil_experiments::claims::Verdict::of_difference(
-        d.r_task_avg.mean,
-        d.r_task_avg.se,
-        true,
-    )
-    .word();
+    let expected =
+        hil_experiments::claims::Verdict::of_difference(d.r_task_avg.mean, d.r_task_avg.se, true)
+            .word();
     assert_eq!(d.verdict, Some(expected));
     // One seed leaves the error, and so the verdict, undefined.
     let one = UserStudyOverSeeds::of(vec![21], &singles[..1]).unwrap();

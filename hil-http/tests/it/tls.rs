@@ -199,3 +199,44 @@ fn a_stored_token_is_the_owners_only_and_stays() {
     assert!(e.to_string().contains("t.token"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The self-signed certificate is a well-formed X.509 server certificate
+/// whose signature checks: a WebPKI verifier that trusts it as its own
+/// root accepts it for every name it was made for, and no other.
+#[test]
+fn the_self_signed_certificate_verifies_as_its_own_root_for_its_names() {
+    use rustls::client::WebPkiServerVerifier;
+    use rustls::client::danger::ServerCertVerifier;
+    use rustls::pki_types::{ServerName, UnixTime};
+
+    let dir = temp("webpki");
+    let tls =
+        Tls::self_signed_in(&dir, &["lab-laptop.local".into(), "192.168.1.20".into()]).unwrap();
+    let mut roots = rustls::RootCertStore::empty();
+    roots.add(tls.certificate().clone()).unwrap();
+    let provider = Arc::new(rustls::crypto::ring::default_provider());
+    let verifier = WebPkiServerVerifier::builder_with_provider(Arc::new(roots), provider)
+        .build()
+        .unwrap();
+    let verify = |name: &str| {
+        verifier.verify_server_cert(
+            tls.certificate(),
+            &[],
+            &ServerName::try_from(name.to_string()).unwrap(),
+            &[],
+            UnixTime::now(),
+        )
+    };
+    for name in [
+        "localhost",
+        "127.0.0.1",
+        "::1",
+        "lab-laptop.local",
+        "192.168.1.20",
+    ] {
+        verify(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+    assert!(verify("example.org").is_err());
+    assert!(verify("10.0.0.1").is_err());
+    let _ = std::fs::remove_dir_all(dir);
+}

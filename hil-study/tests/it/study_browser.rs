@@ -59,9 +59,10 @@ fn type_text(b: &Browser, text: &str) {
     b.keys(&refs);
 }
 
-/// Waits until the element with id `id` has the focus.
+/// Waits until the element with id `id` has the focus (generously: a loaded
+/// machine can take seconds to run the page's script).
 fn wait_focus(b: &Browser, ids: &[&str]) -> bool {
-    let deadline = Instant::now() + Duration::from_secs(5);
+    let deadline = Instant::now() + Duration::from_secs(20);
     while Instant::now() < deadline {
         let f = b.script("return document.activeElement ? document.activeElement.id : '';");
         if ids.iter().any(|id| f == json!(id)) {

@@ -2,6 +2,8 @@
 
 mod cmd;
 mod out;
+#[cfg(not(feature = "speech"))]
+mod speech_unavailable;
 
 use std::process::ExitCode;
 

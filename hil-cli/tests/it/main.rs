@@ -24,4 +24,6 @@ mod terminal_pty;
 mod web_run;
 #[cfg(not(feature = "physics"))]
 mod without_physics;
+#[cfg(not(feature = "speech"))]
+mod without_speech;
 mod workload_seeds;

@@ -1,7 +1,6 @@
 //! `hil bench speech`: the spoken channel's recognition figures on a corpus
 //! made at run time (the logic is `hil_speech::bench`; this file parses
-//! and prints). Naming `hil_speech` here also links it into `hil`, so that
-//! `[channel] type = "speech"` is known to `hil run` and `hil demo`.
+//! and prints).
 
 use hil_core::Result;
 
@@ -70,9 +69,5 @@ pub fn run(a: &SpeechBench) -> Result<()> {
 
 #[cfg(not(feature = "speech"))]
 pub fn run(_a: &SpeechBench) -> Result<()> {
-    use hil_speech as _;
-    Err(hil_core::HilError::channel(
-        "speech",
-        "this hil was built without speech: run scripts/setup-speech, then build with `--features speech`",
-    ))
+    Err(crate::speech_unavailable::error())
 }

@@ -19,6 +19,8 @@
 //! - [`testing`]: the conformance suites.
 
 use pyo3::prelude::*;
+// Links `[channel] type = "speech"` (hil.channels.speech).
+use hil_speech as _;
 
 mod components;
 mod convert;
@@ -43,6 +45,10 @@ fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // run the Kinova environment: the `kinova` feature turns on MuJoCo
     // physics (without it the type parses but refuses to build).
     m.add("KINOVA", cfg!(feature = "kinova"))?;
+    // Whether `QueryChannel("speech", ...)` can hear: the `speech` feature
+    // links the recognizer (without it the type parses but refuses to
+    // build, naming the feature). Naming the crate links its config type.
+    m.add("SPEECH", cfg!(feature = "speech"))?;
     // Python components run on the job runner's workers (rayon's global
     // pool by default): give them a main thread's stack, as
     // `hil_jobs::Runner::new` does, before anything starts that pool

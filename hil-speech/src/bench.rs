@@ -89,7 +89,8 @@ fn queries() -> Vec<Query> {
         .collect()
 }
 
-fn sox_noise(path: &Path, rate: u32, seconds: u32) -> Result<Audio> {
+/// Pink noise from sox (`-R`: the same every run), read back.
+pub fn sox_noise(path: &Path, rate: u32, seconds: u32) -> Result<Audio> {
     let out = Command::new("sox")
         .args(["-R", "-n", "-c", "1", "-b", "16", "-r"])
         .arg(rate.to_string())
@@ -114,76 +115,140 @@ fn sox_noise(path: &Path, rate: u32, seconds: u32) -> Result<Audio> {
     Audio::read_wav(path)
 }
 
-/// Runs the bench; `progress` is told each (done, total).
-pub fn run(
-    settings: &BenchSettings,
-    mut progress: impl FnMut(usize, usize),
-) -> Result<Vec<BenchRow>> {
-    std::fs::create_dir_all(&settings.scratch).map_err(|e| {
-        HilError::channel(
-            "speech",
-            format!("cannot create {}: {e}", settings.scratch.display()),
-        )
-    })?;
-    let mut recognizer = SphinxRecognizer::new(&settings.model_dir)?;
-    // Every (grammar, phrase, meaning) of every query kind.
-    let mut items: Vec<(Grammar, String, Meaning)> = Vec::new();
+/// Every (grammar, phrase, meaning) of every query kind: what the corpus
+/// says.
+pub fn corpus_items() -> Vec<(Grammar, String, Meaning)> {
+    let mut items = Vec::new();
     for q in queries() {
         let g = Grammar::for_query(&q);
         for (phrase, meaning) in g.phrases().to_vec() {
             items.push((g.clone(), phrase, meaning));
         }
     }
-    let total = items.len() * settings.voices.len() * settings.rates.len() * settings.snrs_db.len();
-    let mut per_snr: Vec<Vec<(bool, bool, bool, f64)>> = vec![Vec::new(); settings.snrs_db.len()];
+    items
+}
+
+/// One utterance of the corpus.
+#[derive(Debug)]
+pub struct CorpusUtterance<'a> {
+    /// The grammar of the query it answers.
+    pub grammar: &'a Grammar,
+    /// What is said...
+    pub phrase: &'a str,
+    /// ...and what it means.
+    pub meaning: Meaning,
+    /// The voice and rate saying it.
+    pub voice: &'a EspeakVoice,
+    /// Its index in the SNRs walked (`None` among them: clean).
+    pub snr_index: usize,
+    /// The audio: the phrase in silence, with the noise mixed in.
+    pub audio: Audio,
+}
+
+/// Makes every utterance of the corpus — each phrase of [`corpus_items`]
+/// in each voice and rate, clean or mixed with sox's pink noise at each of
+/// `snrs_db` — and hands it to `each`. The k-th phrase said gets the
+/// noise rotated by `(k * noise_stride + noise_offset)` samples, so that
+/// two corpora (the bench's, a tuning one) can use different stretches.
+#[allow(clippy::too_many_arguments)]
+pub fn walk_corpus(
+    voices: &[String],
+    rates: &[u32],
+    snrs_db: &[Option<f64>],
+    noise_stride: usize,
+    noise_offset: usize,
+    scratch: &Path,
+    mut each: impl FnMut(CorpusUtterance<'_>) -> Result<()>,
+) -> Result<()> {
+    std::fs::create_dir_all(scratch).map_err(|e| {
+        HilError::channel(
+            "speech",
+            format!("cannot create {}: {e}", scratch.display()),
+        )
+    })?;
+    let items = corpus_items();
     let mut noise: Option<Audio> = None;
-    let mut done = 0;
     let mut k = 0usize;
-    for voice in &settings.voices {
-        for &rate in &settings.rates {
+    for voice in voices {
+        for &rate in rates {
             let v = EspeakVoice {
                 voice: voice.clone(),
                 rate,
             };
             for (grammar, phrase, meaning) in &items {
-                let clean = crate::listener::say(&v, phrase, &settings.scratch)?;
+                let clean = crate::listener::say(&v, phrase, scratch)?;
                 if noise.as_ref().is_none_or(|n| n.rate != clean.rate) {
-                    noise = Some(sox_noise(
-                        &settings.scratch.join("noise.wav"),
-                        clean.rate,
-                        30,
-                    )?);
+                    noise = Some(sox_noise(&scratch.join("noise.wav"), clean.rate, 30)?);
                 }
                 let n = noise.as_ref().expect("made above");
                 k += 1;
-                for (i, snr) in settings.snrs_db.iter().enumerate() {
+                for (snr_index, snr) in snrs_db.iter().enumerate() {
                     let audio = match snr {
                         None => clean.clone(),
                         Some(db) => {
                             // A different stretch of the noise each time.
                             let mut shifted = n.clone();
                             let len = shifted.samples.len();
-                            shifted.samples.rotate_left((k * 7919) % len);
+                            shifted
+                                .samples
+                                .rotate_left((k * noise_stride + noise_offset) % len);
                             mix_at_snr(&clean, &shifted, *db)?
                         }
                     };
-                    let mut stream = MemoryStream::new(audio);
-                    let h = hear(&mut stream, &settings.channel, &mut recognizer, grammar)?;
-                    let said = h.recognition.as_ref().and_then(|r| r.meaning);
-                    let right = said == Some(*meaning);
-                    let accepted = matches!(h.outcome, Outcome::Accepted | Outcome::Repeat);
-                    per_snr[i].push((
-                        right,
-                        accepted && !right,
-                        !accepted,
-                        h.latency_ms.unwrap_or(f64::NAN),
-                    ));
-                    done += 1;
-                    progress(done, total);
+                    each(CorpusUtterance {
+                        grammar,
+                        phrase,
+                        meaning: *meaning,
+                        voice: &v,
+                        snr_index,
+                        audio,
+                    })?;
                 }
             }
         }
     }
+    Ok(())
+}
+
+/// The bench's stretch of the noise: rotated by `k * 7919` samples.
+pub const BENCH_NOISE_STRIDE: usize = 7919;
+
+/// Runs the bench; `progress` is told each (done, total).
+pub fn run(
+    settings: &BenchSettings,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Vec<BenchRow>> {
+    let mut recognizer = SphinxRecognizer::new(&settings.model_dir)?;
+    let total = corpus_items().len()
+        * settings.voices.len()
+        * settings.rates.len()
+        * settings.snrs_db.len();
+    let mut per_snr: Vec<Vec<(bool, bool, bool, f64)>> = vec![Vec::new(); settings.snrs_db.len()];
+    let mut done = 0;
+    walk_corpus(
+        &settings.voices,
+        &settings.rates,
+        &settings.snrs_db,
+        BENCH_NOISE_STRIDE,
+        0,
+        &settings.scratch,
+        |u| {
+            let mut stream = MemoryStream::new(u.audio);
+            let h = hear(&mut stream, &settings.channel, &mut recognizer, u.grammar)?;
+            let said = h.recognition.as_ref().and_then(|r| r.meaning);
+            let right = said == Some(u.meaning);
+            let accepted = matches!(h.outcome, Outcome::Accepted | Outcome::Repeat);
+            per_snr[u.snr_index].push((
+                right,
+                accepted && !right,
+                !accepted,
+                h.latency_ms.unwrap_or(f64::NAN),
+            ));
+            done += 1;
+            progress(done, total);
+            Ok(())
+        },
+    )?;
     let _ = std::fs::remove_dir_all(&settings.scratch);
     Ok(settings
         .snrs_db

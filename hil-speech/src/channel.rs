@@ -181,13 +181,15 @@ impl SpeechChannel {
                 HilError::channel("speech", format!("cannot create {}: {e}", dir.display()))
             })?;
         }
+        let stop = Arc::new(AtomicBool::new(false));
+        crate::stop::register(&stop);
         Ok(Self {
             voice,
             source,
             recognizer,
             fallback: None,
             settings,
-            stop: Arc::new(AtomicBool::new(false)),
+            stop,
             turns: Vec::new(),
         })
     }
@@ -200,8 +202,9 @@ impl SpeechChannel {
     }
 
     /// The flag that stops the channel between utterances: set it (from a
-    /// Ctrl-C handler, e.g. `signal_hook::flag::register`) and the next
-    /// turn returns an error instead of listening.
+    /// Ctrl-C handler, e.g. `signal_hook::flag::register`, or for every
+    /// channel at once with [`crate::stop::stop_all`], as `hil run` does)
+    /// and the next turn returns an error instead of listening.
     pub fn stop_flag(&self) -> Arc<AtomicBool> {
         self.stop.clone()
     }
@@ -382,6 +385,7 @@ impl QueryChannel for SpeechChannel {
             self.check_stop(query)?;
             self.voice.say(&again)?;
         }
+        self.check_stop(query)?;
         if let Some(fallback) = self.fallback.as_mut() {
             self.voice.say("I'll ask on the screen instead.")?;
             return fallback.ask(query);

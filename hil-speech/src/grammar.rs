@@ -183,6 +183,18 @@ impl Grammar {
         Self { phrases }
     }
 
+    /// This grammar without the phrases meaning `meaning`: what is left for
+    /// the best *different* answer (none when nothing would be left).
+    pub fn without(&self, meaning: Meaning) -> Option<Self> {
+        let phrases: Vec<(String, Meaning)> = self
+            .phrases
+            .iter()
+            .filter(|(_, m)| *m != meaning)
+            .cloned()
+            .collect();
+        (!phrases.is_empty()).then_some(Self { phrases })
+    }
+
     /// Every phrase and its meaning.
     pub fn phrases(&self) -> &[(String, Meaning)] {
         &self.phrases

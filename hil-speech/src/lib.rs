@@ -20,6 +20,7 @@ pub mod recognize;
 pub mod source;
 #[cfg(feature = "engines")]
 pub mod sphinx;
+pub mod stop;
 pub mod tts;
 
 pub use channel::{SpeechChannel, SpeechSettings};

@@ -1,7 +1,7 @@
 //! The offline recognizer: Debian's pocketsphinx (5prealpha) through a small
 //! FFI, decoding an utterance restricted to the query's grammar (JSGF). The
-//! best path is what was said; its posterior probability in the lattice of
-//! the grammar's alternatives is its confidence. (A free phone loop as a
+//! best path is what was said (how sure the recognizer is comes from
+//! comparing decodings: `crate::recognize`). (A free phone loop as a
 //! second, out-of-grammar pass was tried: Debian's allphone search took
 //! about 5 s of CPU per second of audio here, far over the latency budget.)
 
@@ -116,10 +116,11 @@ fn sphinx_error(what: impl Into<String>) -> HilError {
 }
 
 impl Sphinx {
-    /// A decoder on the model files, with pocketsphinx's log silenced.
-    pub fn new(model: &ModelFiles) -> Result<Self> {
+    /// A decoder on the model files, with pocketsphinx's log silenced and
+    /// `options` (pairs such as `["-dither", "yes"]`) after the model's.
+    pub fn new(model: &ModelFiles, options: &[&str]) -> Result<Self> {
         let path = |p: &Path| p.to_string_lossy().into_owned();
-        let args = [
+        let mut args = vec![
             "hil".to_string(),
             "-hmm".into(),
             path(&model.hmm),
@@ -128,6 +129,7 @@ impl Sphinx {
             "-logfn".into(),
             "/dev/null".into(),
         ];
+        args.extend(options.iter().map(|o| o.to_string()));
         let c_args: Vec<CString> = args
             .iter()
             .map(|a| CString::new(a.as_str()).map_err(|_| sphinx_error("a NUL byte in a path")))
@@ -182,20 +184,26 @@ impl Sphinx {
 
     /// Decodes 16 kHz mono samples with the grammar (set first).
     pub fn decode(&mut self, samples: &[i16]) -> Result<Decoded> {
+        self.decode_as(samples, false)
+    }
+
+    /// Decodes as a live stream, or (`whole`) as one utterance, which
+    /// pocketsphinx normalises over its whole length.
+    pub fn decode_as(&mut self, samples: &[i16], whole: bool) -> Result<Decoded> {
         if self.grammar.is_none() {
             return Err(sphinx_error("no grammar was set before decoding"));
         }
         let ps = self.ps.as_ptr();
         let search = GRAMMAR;
-        // Fed as a live stream (full_utt = 0), as pocketsphinx_continuous
-        // does: with full_utt = 1 (whole-utterance normalisation) "option
-        // six" in en-us was decoded as "option three" (tests/session.rs).
+        // Live (full_utt = 0): features are normalised as they come, as
+        // pocketsphinx_continuous does; whole (full_utt = 1): over the whole
+        // utterance. The recognizer decodes both ways and wants agreement.
         // SAFETY: valid decoder; `samples` is a live slice of its length.
         unsafe {
             if ps_set_search(ps, search.as_ptr()) != 0 || ps_start_utt(ps) != 0 {
                 return Err(sphinx_error("pocketsphinx could not start an utterance"));
             }
-            if ps_process_raw(ps, samples.as_ptr(), samples.len(), 0, 0) < 0 {
+            if ps_process_raw(ps, samples.as_ptr(), samples.len(), 0, c_int::from(whole)) < 0 {
                 ps_end_utt(ps);
                 return Err(sphinx_error("pocketsphinx failed to decode the audio"));
             }

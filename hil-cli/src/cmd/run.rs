@@ -147,7 +147,10 @@ fn run_session(args: &RunArgs) -> hil_core::Result<ExperimentSummary> {
 /// On Ctrl-C (or SIGTERM), says what was kept and how to continue, then
 /// exits with status 130. Every step answered so far is already on disk
 /// (steps are fsync'ed before the robot acts); a line cut short by the
-/// interrupt is discarded by `--resume`.
+/// interrupt is discarded by `--resume`. A session answering by voice is
+/// stopped between utterances instead (`hil_speech::stop`): the answer
+/// being spoken is heard and kept, then the channel ends the session; a
+/// second Ctrl-C exits at once.
 #[cfg(unix)]
 fn install_interrupt_notice(log: Option<PathBuf>, key: Option<PathBuf>) {
     use signal_hook::consts::{SIGINT, SIGTERM};
@@ -170,9 +173,25 @@ fn install_interrupt_notice(log: Option<PathBuf>, key: Option<PathBuf>) {
                         "\ninterrupted: no interaction log was kept (run with --log LOG to be able to resume)"
                     ),
                 }
+                if stop_spoken_channels() > 0 {
+                    note!("stopping after the answer being spoken (Ctrl-C again to quit now)");
+                    if signals.forever().next().is_none() {
+                        return;
+                    }
+                }
                 std::process::exit(130);
             }
         });
+}
+
+/// Raises the stop flag of every live spoken channel; how many there were
+/// (none in a build without `speech`).
+#[cfg(unix)]
+fn stop_spoken_channels() -> usize {
+    #[cfg(feature = "speech")]
+    return hil_speech::stop::stop_all();
+    #[cfg(not(feature = "speech"))]
+    0
 }
 
 #[cfg(not(unix))]

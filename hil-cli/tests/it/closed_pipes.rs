@@ -4,9 +4,10 @@
 //! run` from stopping on SIGTERM, nor stops a run that prints progress.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::common::{send_signal, wait_at_most};
 use crate::demo::{DemoSession, scratch_dir};
 
 /// 128 + SIGPIPE: what `yes | head -1` reports for `yes`.
@@ -113,17 +114,6 @@ fn run_with_closed_stderr(dir: &Path, episodes: usize, quiet: bool) -> (Child, P
     (child, log)
 }
 
-fn wait_at_most(child: &mut Child, limit: Duration) -> Option<ExitStatus> {
-    let deadline = Instant::now() + limit;
-    while Instant::now() < deadline {
-        if let Some(status) = child.try_wait().unwrap() {
-            return Some(status);
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    None
-}
-
 #[test]
 fn sigterm_stops_a_run_whose_stderr_reader_has_gone() {
     let dir = scratch_dir("closed-pipes", "sigterm");
@@ -138,12 +128,7 @@ fn sigterm_stops_a_run_whose_stderr_reader_has_gone() {
         );
         std::thread::sleep(Duration::from_millis(10));
     }
-    let killed = Command::new("kill")
-        .arg("-TERM")
-        .arg(child.id().to_string())
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    send_signal(&child, "-TERM");
     let status = wait_at_most(&mut child, Duration::from_secs(20));
     if status.is_none() {
         let _ = child.kill();

@@ -19,6 +19,8 @@ mod record_cmd;
 mod reproduce;
 mod resume;
 mod run_reliability;
+#[cfg(feature = "speech")]
+mod speech_interrupt;
 mod study_resume;
 mod terminal_pty;
 mod web_run;

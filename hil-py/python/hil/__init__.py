@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Optional
 
-from . import testing
+from . import channels, testing
 from .decisions import Act, Diagnostics, Query, QueryKind
 from ._hil import (
     KINOVA,
@@ -57,6 +57,7 @@ if _ilu.find_spec("gymnasium") is not None:
     from . import envs  # noqa: F401  (registers hil/FoodReplay-v0)
 
 __all__ = [
+    "channels",
     "Act",
     "Diagnostics",
     "Query",

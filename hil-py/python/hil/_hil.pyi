@@ -14,6 +14,7 @@ import numpy.typing as npt
 __version__: str
 PAPER_ALPHA: float
 KINOVA: bool
+SPEECH: bool
 
 _Path = Union[str, "PathLike[str]"]
 _Actions = Union[int, Sequence[str]]

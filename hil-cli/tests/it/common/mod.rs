@@ -1,6 +1,7 @@
 //! Shared by the integration tests that run the `hil` binary.
 
-use std::process::{Command, Output};
+use std::process::{Child, Command, ExitStatus, Output};
+use std::time::{Duration, Instant};
 
 /// Runs the built `hil` binary with `args` and returns its output.
 pub fn hil(args: &[&str]) -> Output {
@@ -32,4 +33,26 @@ pub fn report_kept_as_page(name: &str, args: &[&str], command: &str) -> String {
     assert!(md.contains(command), "{md}");
     let _ = std::fs::remove_dir_all(&dir);
     report
+}
+
+/// The child's exit status, if it ends within `limit`.
+pub fn wait_at_most(child: &mut Child, limit: Duration) -> Option<ExitStatus> {
+    let deadline = Instant::now() + limit;
+    while Instant::now() < deadline {
+        if let Some(status) = child.try_wait().unwrap() {
+            return Some(status);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    None
+}
+
+/// Sends `signal` (e.g. `-INT`, `-TERM`) to `child` with kill(1).
+pub fn send_signal(child: &Child, signal: &str) {
+    let sent = Command::new("kill")
+        .arg(signal)
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(sent.success(), "kill {signal} failed");
 }

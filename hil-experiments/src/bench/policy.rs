@@ -47,14 +47,19 @@ pub struct PolicyBench {
     pub probe_bytes: usize,
 }
 
-/// What one step of the built-in estimator reads and writes.
+/// What one step of the built-in estimator reads and writes, over the
+/// timed steps. The estimator grows as it learns (one observation per
+/// step, and one stored row per fresh context), so the figures are means
+/// over the steps, each step counted at the state it ran on.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Traffic {
-    /// `kernel`, `dense` or `mixed` (over the arms).
+    /// `kernel`, `dense` or `mixed` (over the arms, before the first step).
     pub representation: &'static str,
-    /// Bytes read by one score of every arm plus one update.
+    /// Bytes read by one score of every arm plus one update (mean).
     pub bytes_read: usize,
-    /// Bytes one update writes.
+    /// Bytes read by the first and by the last timed step.
+    pub bytes_read_range: (usize, usize),
+    /// Bytes one update writes (mean).
     pub bytes_written: usize,
 }
 
@@ -194,9 +199,10 @@ impl PolicyBench {
         // The built-in policies' memory traffic, read off a twin of their
         // estimator: same options and data, so the build context's memo
         // hands back the estimator the policy was built from (no second
-        // pretraining).
-        let traffic = match EstimatorConfig::from_policy_table(&table)? {
-            Some(est) => Some(Traffic::of(&est.build_estimator(&ctx)?)?),
+        // pretraining). The twin is fed the policy's observations after the
+        // clock stops (see `Traffic::over`).
+        let twin = match EstimatorConfig::from_policy_table(&table)? {
+            Some(est) => Some(est.build_estimator(&ctx)?),
             None => None,
         };
         drop(ctx);
@@ -208,7 +214,7 @@ impl PolicyBench {
         } else {
             self.probe_bytes
         } / std::mem::size_of::<f64>();
-        let bw_buf: Vec<f64> = if traffic.is_some() {
+        let bw_buf: Vec<f64> = if twin.is_some() {
             (0..probe_len).map(|i| (i % 7) as f64).collect()
         } else {
             Vec::new()
@@ -220,6 +226,11 @@ impl PolicyBench {
         let mut step_us = Vec::with_capacity(self.steps);
         let mut decide_us = Vec::with_capacity(self.steps);
         let mut queries = 0usize;
+        let mut observed = Vec::with_capacity(if twin.is_some() {
+            self.steps + warmup
+        } else {
+            0
+        });
         for s in 0..(self.steps + warmup) {
             if s % 20 == 0 && !bw_buf.is_empty() {
                 bw_samples.push(read_bandwidth(&bw_buf));
@@ -255,6 +266,9 @@ impl PolicyBench {
             if let Choice::Query { kind, .. } = d.choice {
                 history.push(t, kind)?;
             }
+            if twin.is_some() {
+                observed.push((x, arm, reward));
+            }
             if s >= warmup {
                 queries += usize::from(expert);
                 let total = (mid - start) + (end - mid2);
@@ -268,6 +282,10 @@ impl PolicyBench {
             bw_samples.push(read_bandwidth(&bw_buf));
             median(&bw_samples)
         });
+        let traffic = match twin {
+            Some(twin) => Some(Traffic::over(twin, &observed, warmup)?),
+            None => None,
+        };
         let floors = traffic
             .zip(bw)
             .map(|(tr, bw)| Floors::new(&tr, bw, per_step_us, p10_step_us));
@@ -309,6 +327,8 @@ impl PolicyBenchReport {
             "pretrain_s": self.pretrain_s,
             "queries": self.queries,
             "bytes_per_step": traffic.map(|t| t.bytes_read),
+            "bytes_per_step_first": traffic.map(|t| t.bytes_read_range.0),
+            "bytes_per_step_last": traffic.map(|t| t.bytes_read_range.1),
             "read_bandwidth_gb_s": floors.map(|f| f.bandwidth / 1e9),
             "bandwidth_floor_us": floors.map(|f| f.floor_us),
             "ratio_to_floor": floors.map(|f| f.ratio),
@@ -326,8 +346,11 @@ impl PolicyBenchReport {
     pub fn summary(&self, bench: &PolicyBench) -> String {
         let memory = match (self.traffic, self.floors) {
             (Some(t), Some(f)) => format!(
-                "{} bytes/step, read bandwidth {:.2} GB/s, floor {:.1} µs, ratio {:.2}",
+                "{} bytes/step (mean; first {}, last {}), read bandwidth {:.2} GB/s, \
+                 floor {:.1} µs, ratio {:.2}",
                 t.bytes_read,
+                t.bytes_read_range.0,
+                t.bytes_read_range.1,
                 f.bandwidth / 1e9,
                 f.floor_us,
                 f.ratio
@@ -353,7 +376,16 @@ impl PolicyBenchReport {
 }
 
 impl Traffic {
-    fn of(arms: &LinearArms) -> Result<Self> {
+    /// The traffic of the timed steps: `arms` (a twin of the policy's
+    /// estimator before the first step) is given the policy's observations
+    /// in order, and each step after the first `warmup` is counted at the
+    /// state it ran on. Replayed after the clock stops, so the twin's own
+    /// work never disturbs the timing.
+    fn over(
+        mut arms: LinearArms,
+        observed: &[(Context, ArmId, f64)],
+        warmup: usize,
+    ) -> Result<Self> {
         let reprs: Vec<Representation> = (0..arms.n_arms())
             .map(|i| arms.representation(ArmId(i)))
             .collect::<Result<_>>()?;
@@ -364,16 +396,29 @@ impl Traffic {
         } else {
             "mixed"
         };
-        let bytes_per_update = arms.bytes_per_update(ArmId(0))?;
-        // A dense update rewrites the factor it read; a kernel update appends O(n).
-        let bytes_written = match arms.representation(ArmId(0))? {
-            Representation::Dense => bytes_per_update,
-            Representation::Kernel => 0,
-        };
+        let (mut read, mut written) = (Vec::new(), Vec::new());
+        for (s, (x, arm, reward)) in observed.iter().enumerate() {
+            if s >= warmup {
+                let update = arms.bytes_per_update(*arm)?;
+                read.push(arms.bytes_per_score() + update);
+                // A dense update rewrites the factor it read; a kernel
+                // update appends O(n).
+                written.push(match arms.representation(*arm)? {
+                    Representation::Dense => update,
+                    Representation::Kernel => 0,
+                });
+            }
+            arms.update(x, *arm, *reward)?;
+        }
+        let mean = |v: &[usize]| (v.iter().sum::<usize>() as f64 / v.len().max(1) as f64).round();
         Ok(Self {
             representation,
-            bytes_read: arms.bytes_per_score() + bytes_per_update,
-            bytes_written,
+            bytes_read: mean(&read) as usize,
+            bytes_read_range: (
+                read.first().copied().unwrap_or(0),
+                read.last().copied().unwrap_or(0),
+            ),
+            bytes_written: mean(&written) as usize,
         })
     }
 }
@@ -449,6 +494,19 @@ mod tests {
         assert_eq!(j["representation"], "kernel");
         assert_eq!(j["data"], "synthetic");
         assert!(r.summary(&b).contains("ratio"));
+    }
+
+    #[test]
+    fn the_floor_counts_what_each_step_reads_as_the_estimator_grows() {
+        let mut b = small("linucb_qg");
+        b.spec.representation = Some("kernel".into());
+        let t = b.run().unwrap().traffic.unwrap();
+        let (first, last) = t.bytes_read_range;
+        // Every step stores its fresh context (16 numbers) and adds one
+        // observation to a factor: the last timed step reads at least the
+        // 24 rows added since the first.
+        assert!(last >= first + 24 * 16 * 8, "{t:?}");
+        assert!(first < t.bytes_read && t.bytes_read < last, "{t:?}");
     }
 
     #[test]

@@ -5,6 +5,9 @@
 //! accumulation orders (results are bit-reproducible run to run, which the
 //! checkpoint replay relies on).
 
+#[cfg(target_arch = "x86_64")]
+mod multirow;
+
 /// Dot product with eight independent accumulators and a fixed summation
 /// order (bit-reproducible on a given machine).
 ///
@@ -55,7 +58,7 @@ fn dot_portable(a: &[f64], b: &[f64]) -> f64 {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn dot_avx2(a: &[f64], b: &[f64]) -> f64 {
+pub(super) fn dot_avx2(a: &[f64], b: &[f64]) -> f64 {
     dot_body!(a, b, f64::mul_add)
 }
 
@@ -63,66 +66,55 @@ fn dot_avx2(a: &[f64], b: &[f64]) -> f64 {
 /// to end, each bit-identical to [`dot`] of that row (same accumulators,
 /// same order).
 ///
-/// Rows are taken four at a time, so that each chunk of `x` is loaded once
-/// for four rows and 32 independent accumulators keep the FMA units busy:
-/// one [`dot`] per row waits on its 8 accumulators' latency and streams
-/// the rows at about half the machine's read bandwidth.
+/// Several rows are taken at once, so that each chunk of `x` is loaded once
+/// for all of them and their independent accumulators keep the FMA units
+/// busy: one [`dot`] per row waits on its 8 accumulators' latency and
+/// streams the rows at about half the machine's read bandwidth.
 pub(crate) fn dot_rows(rows: &[f64], x: &[f64], out: &mut Vec<f64>) {
     #[cfg(target_arch = "x86_64")]
     if has_avx2_fma() {
         // SAFETY: the CPU supports the features `dot_rows_avx2` is compiled for.
-        return unsafe { dot_rows_avx2(rows, x, out) };
+        return unsafe { multirow::dot_rows_avx2(rows, x, out) };
     }
     dot_rows_portable(rows, x, out)
 }
 
-macro_rules! dot_rows_body {
-    ($rows:expr, $x:expr, $out:expr, $fma:expr, $dot:expr) => {{
-        let (rows, x, out): (&[f64], &[f64], &mut Vec<f64>) = ($rows, $x, $out);
-        let d = x.len();
-        let mut blocks = rows.chunks_exact(4 * d);
-        for block in &mut blocks {
-            let (r0, rest) = block.split_at(d);
-            let (r1, rest) = rest.split_at(d);
-            let (r2, r3) = rest.split_at(d);
-            let mut acc = [[0.0f64; 8]; 4];
-            let n8 = d / 8 * 8;
-            let chunks = x
-                .chunks_exact(8)
-                .zip(r0.chunks_exact(8))
-                .zip(r1.chunks_exact(8))
-                .zip(r2.chunks_exact(8))
-                .zip(r3.chunks_exact(8));
-            for ((((xc, c0), c1), c2), c3) in chunks {
-                for k in 0..8 {
-                    acc[0][k] = $fma(c0[k], xc[k], acc[0][k]);
-                    acc[1][k] = $fma(c1[k], xc[k], acc[1][k]);
-                    acc[2][k] = $fma(c2[k], xc[k], acc[2][k]);
-                    acc[3][k] = $fma(c3[k], xc[k], acc[3][k]);
-                }
-            }
-            for (a, r) in acc.iter().zip([r0, r1, r2, r3]) {
-                let mut tail = 0.0;
-                for (p, q) in r[n8..].iter().zip(&x[n8..]) {
-                    tail = $fma(*p, *q, tail);
-                }
-                out.push(((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7])) + tail);
-            }
-        }
-        for r in blocks.remainder().chunks_exact(d) {
-            out.push($dot(r, x));
-        }
-    }};
-}
-
+/// The scan without target features: four rows at a time (the portable
+/// build has no fused multiply-add, so the loop is bound by its adds).
 fn dot_rows_portable(rows: &[f64], x: &[f64], out: &mut Vec<f64>) {
-    dot_rows_body!(rows, x, out, mul_add_plain, dot_portable)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn dot_rows_avx2(rows: &[f64], x: &[f64], out: &mut Vec<f64>) {
-    dot_rows_body!(rows, x, out, f64::mul_add, |r, x| dot_avx2(r, x))
+    let d = x.len();
+    let mut blocks = rows.chunks_exact(4 * d);
+    for block in &mut blocks {
+        let (r0, rest) = block.split_at(d);
+        let (r1, rest) = rest.split_at(d);
+        let (r2, r3) = rest.split_at(d);
+        let mut acc = [[0.0f64; 8]; 4];
+        let n8 = d / 8 * 8;
+        let chunks = x
+            .chunks_exact(8)
+            .zip(r0.chunks_exact(8))
+            .zip(r1.chunks_exact(8))
+            .zip(r2.chunks_exact(8))
+            .zip(r3.chunks_exact(8));
+        for ((((xc, c0), c1), c2), c3) in chunks {
+            for k in 0..8 {
+                acc[0][k] = mul_add_plain(c0[k], xc[k], acc[0][k]);
+                acc[1][k] = mul_add_plain(c1[k], xc[k], acc[1][k]);
+                acc[2][k] = mul_add_plain(c2[k], xc[k], acc[2][k]);
+                acc[3][k] = mul_add_plain(c3[k], xc[k], acc[3][k]);
+            }
+        }
+        for (a, r) in acc.iter().zip([r0, r1, r2, r3]) {
+            let mut tail = 0.0;
+            for (p, q) in r[n8..].iter().zip(&x[n8..]) {
+                tail = mul_add_plain(*p, *q, tail);
+            }
+            out.push(((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7])) + tail);
+        }
+    }
+    for r in blocks.remainder().chunks_exact(d) {
+        out.push(dot_portable(r, x));
+    }
 }
 
 /// Whether the AVX2 + FMA variants can run here.
@@ -158,8 +150,20 @@ pub(crate) fn packed_len(n: usize) -> usize {
 }
 
 /// Solves `L z = k` in place (`k` becomes `z`) for a row-packed lower `L` of
-/// order `k.len()`.
+/// order `k.len()`: z_i = (k_i − dot(L_i,0..i, z_0..i)) / L_ii, with [`dot`]'s
+/// arithmetic (the AVX2 variant solves eight rows at a time, with the same
+/// numbers).
 pub(crate) fn forward_solve_row_packed(l: &[f64], k: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2_fma() {
+        // SAFETY: the CPU supports the features the variant is compiled for.
+        return unsafe { multirow::forward_solve_row_packed_avx2(l, k) };
+    }
+    forward_solve_row_packed_by_rows(l, k)
+}
+
+/// [`forward_solve_row_packed`] one row at a time.
+fn forward_solve_row_packed_by_rows(l: &[f64], k: &mut [f64]) {
     for i in 0..k.len() {
         let off = row_packed_offset(i);
         let row = &l[off..off + i + 1];
@@ -283,7 +287,7 @@ mod tests {
     #[test]
     fn dot_rows_is_dot_of_each_row_bit_for_bit() {
         for d in [1, 7, 8, 13, 64, 2048] {
-            for n in [0, 1, 3, 4, 5, 9] {
+            for n in [0, 1, 3, 4, 5, 8, 9, 17, 23] {
                 let rows: Vec<f64> = (0..n * d)
                     .map(|i| ((i * 37 % 101) as f64 - 50.0) / 7.0)
                     .collect();
@@ -308,6 +312,30 @@ mod tests {
                         "portable d {d} n {n} row {i}"
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn blocked_forward_solve_is_the_row_by_row_solve_bit_for_bit() {
+        for n in [0, 1, 7, 8, 9, 16, 23, 300] {
+            // A well-conditioned lower factor: unit-scale entries, a
+            // dominant diagonal.
+            let l: Vec<f64> = (0..packed_len(n))
+                .map(|p| ((p * 37 % 101) as f64 - 50.0) / 500.0)
+                .collect();
+            let mut l = l;
+            for i in 0..n {
+                l[row_packed_offset(i) + i] = 2.0 + (i % 5) as f64;
+            }
+            let k: Vec<f64> = (0..n)
+                .map(|i| ((i * 13 % 29) as f64 - 14.0) / 3.0)
+                .collect();
+            let (mut blocked, mut by_rows) = (k.clone(), k.clone());
+            forward_solve_row_packed(&l, &mut blocked);
+            forward_solve_row_packed_by_rows(&l, &mut by_rows);
+            for i in 0..n {
+                assert_eq!(blocked[i].to_bits(), by_rows[i].to_bits(), "n {n} row {i}");
             }
         }
     }

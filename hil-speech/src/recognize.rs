@@ -56,11 +56,11 @@ mod engine {
     /// made of; `examples/speech_tune.rs` prints it).
     #[derive(Clone, Debug, PartialEq)]
     pub struct Weighed {
-        /// The live decoding's words.
+        /// The whole-utterance decoding's words.
         pub transcript: String,
         /// Their meaning, if in the grammar.
         pub meaning: Option<Meaning>,
-        /// Whether the whole-utterance decoding means the same.
+        /// Whether the live decoding means the same.
         pub agree: bool,
         /// The smaller of the two decodings' margins over the best answer
         /// with a different meaning, in score units per frame (infinite
@@ -142,10 +142,13 @@ mod engine {
         /// Decodes `samples` every way the confidence needs.
         pub fn weigh(&mut self, grammar: &Grammar, samples: &[i16]) -> Result<Weighed> {
             let samples = with_floor(samples);
-            let live = self.decode(grammar, &samples, false)?;
-            let meaning = grammar.meaning(&live.hypothesis);
+            // The whole-utterance decoding (normalised over the utterance
+            // itself) says what was said; the live one, which starts from
+            // the model's initial normalisation, must mean the same.
+            let whole = self.decode(grammar, &samples, true)?;
+            let meaning = grammar.meaning(&whole.hypothesis);
             let mut weighed = Weighed {
-                transcript: live.hypothesis.clone(),
+                transcript: whole.hypothesis.clone(),
                 meaning,
                 agree: false,
                 margin: 0.0,
@@ -153,8 +156,8 @@ mod engine {
             let Some(m) = meaning else {
                 return Ok(weighed);
             };
-            let whole = self.decode(grammar, &samples, true)?;
-            weighed.agree = grammar.meaning(&whole.hypothesis) == Some(m);
+            let live = self.decode(grammar, &samples, false)?;
+            weighed.agree = grammar.meaning(&live.hypothesis) == Some(m);
             if !weighed.agree {
                 return Ok(weighed);
             }

@@ -45,7 +45,48 @@ unsafe extern "C" {
     fn ps_end_utt(ps: *mut ps_decoder_t) -> c_int;
     fn ps_get_hyp(ps: *mut ps_decoder_t, out_best_score: *mut i32) -> *const c_char;
     fn ps_get_n_frames(ps: *mut ps_decoder_t) -> c_int;
+    fn ps_get_feat(ps: *mut ps_decoder_t) -> *mut FeatHead;
+    fn cmn_live_set(cmn: *mut CmnState, vec: *const f32);
 }
+
+/// The leading fields of sphinxbase's `feat_t` (feat.h, 5prealpha), up to
+/// the CMN state: the decoder exposes no other way to reset it. `Sphinx::new`
+/// checks the layout against what it must hold before using it.
+#[repr(C)]
+#[allow(dead_code)] // every field is there for the layout, few are read
+struct FeatHead {
+    refcount: c_int,
+    name: *mut c_char,
+    cepsize: i32,
+    n_stream: i32,
+    stream_len: *mut u32,
+    window_size: i32,
+    n_sv: i32,
+    sv_len: *mut u32,
+    subvecs: *mut *mut i32,
+    sv_buf: *mut f32,
+    sv_dim: i32,
+    cmn: c_int,
+    varnorm: i32,
+    agc: c_int,
+    compute_feat: *mut c_void,
+    cmn_struct: *mut CmnState,
+}
+
+/// sphinxbase's `cmn_t` (cmn.h; `mfcc_t` is `float` in Debian's build).
+#[repr(C)]
+#[allow(dead_code)] // every field is there for the layout, few are read
+struct CmnState {
+    cmn_mean: *mut f32,
+    cmn_var: *mut f32,
+    sum: *mut f32,
+    nframe: i32,
+    veclen: i32,
+}
+
+/// sphinxbase's `cmn_type_t`: over the whole utterance, or running.
+const CMN_BATCH: c_int = 1;
+const CMN_LIVE: c_int = 2;
 
 pub use crate::recognize::DEFAULT_MODEL_DIR;
 
@@ -103,6 +144,9 @@ pub struct Sphinx {
     ps: NonNull<ps_decoder_t>,
     config: NonNull<cmd_ln_t>,
     grammar: Option<String>,
+    /// The cepstral mean the model starts from (its `-cmninit`), restored
+    /// before every utterance.
+    initial_mean: Vec<f32>,
 }
 
 // The decoder is used by one thread at a time (`&mut self`), and
@@ -128,6 +172,11 @@ impl Sphinx {
             path(&model.dict),
             "-logfn".into(),
             "/dev/null".into(),
+            // pocketsphinx's own voice activity detector keeps its state
+            // from one utterance to the next (so a decoding depended on the
+            // ones before it); the channel finds the speech itself.
+            "-remove_silence".into(),
+            "no".into(),
         ];
         args.extend(options.iter().map(|o| o.to_string()));
         let c_args: Vec<CString> = args
@@ -158,11 +207,56 @@ impl Sphinx {
                 model.hmm.display()
             )));
         };
-        Ok(Self {
+        let mut sphinx = Self {
             ps,
             config,
             grammar: None,
-        })
+            initial_mean: Vec::new(),
+        };
+        sphinx.initial_mean = sphinx.cmn_state()?.0;
+        Ok(sphinx)
+    }
+
+    /// The feature computation's state: the current cepstral mean and
+    /// where it lives. An error when the library's `feat_t` is not laid out
+    /// as [`FeatHead`] says (another sphinxbase than Debian's 5prealpha).
+    fn cmn_state(&mut self) -> Result<(Vec<f32>, NonNull<FeatHead>)> {
+        let layout = || sphinx_error("this sphinxbase's feature state is not laid out as expected");
+        // SAFETY: valid decoder; the feat_t it returns lives as long as it.
+        let feat = NonNull::new(unsafe { ps_get_feat(self.ps.as_ptr()) }).ok_or_else(layout)?;
+        // SAFETY: feat_t begins with FeatHead's fields (checked below before
+        // any pointer in it is followed beyond the CMN state).
+        let head = unsafe { feat.as_ref() };
+        if head.cepsize != 13 || head.cmn_struct.is_null() {
+            return Err(layout());
+        }
+        // SAFETY: non-null cmn_t of the decoder.
+        let cmn = unsafe { &*head.cmn_struct };
+        if cmn.veclen != head.cepsize || cmn.cmn_mean.is_null() {
+            return Err(layout());
+        }
+        // SAFETY: cmn_mean holds veclen floats.
+        let mean = unsafe { std::slice::from_raw_parts(cmn.cmn_mean, cmn.veclen as usize) };
+        Ok((mean.to_vec(), feat))
+    }
+
+    /// Forgets what earlier utterances taught the feature computation:
+    /// pocketsphinx carries its running cepstral mean from one utterance to
+    /// the next (so the same audio decoded differently after a different
+    /// history); it restarts from the model's initial mean instead, and
+    /// normalises `whole` utterances over their own length (pocketsphinx
+    /// switches the mode to running for good once it decodes live).
+    /// (The front end's noise estimate is reset by `ps_start_utt` itself;
+    /// its voice activity detector is off: see `new`.)
+    fn forget_history(&mut self, whole: bool) -> Result<()> {
+        let (_, mut feat) = self.cmn_state()?;
+        // SAFETY: checked layout; the decoder is not decoding now.
+        unsafe {
+            let head = feat.as_mut();
+            head.cmn = if whole { CMN_BATCH } else { CMN_LIVE };
+            cmn_live_set(head.cmn_struct, self.initial_mean.as_ptr());
+        }
+        Ok(())
     }
 
     /// Makes `jsgf` the grammar of the next decodings (kept when unchanged).
@@ -193,6 +287,7 @@ impl Sphinx {
         if self.grammar.is_none() {
             return Err(sphinx_error("no grammar was set before decoding"));
         }
+        self.forget_history(whole)?;
         let ps = self.ps.as_ptr();
         let search = GRAMMAR;
         // Live (full_utt = 0): features are normalised as they come, as

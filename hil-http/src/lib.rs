@@ -15,7 +15,9 @@
 //!   single-switch scanning script, compiled-in assets, and item pictures
 //!   from a folder.
 //! - [`tls`]: HTTPS ([`Server::start_tls`]) with the lab's certificate or
-//!   a self-signed one kept in the data folder, and its fingerprint.
+//!   a self-signed one kept in the data folder, and its fingerprint
+//!   (cargo feature `tls`; without it, asking for HTTPS is an error that
+//!   says how to get it).
 //! - [`urls`]: the URLs to print for the address the server is bound to.
 //! - [`secrets`]: tokens and keys kept between runs in files only their
 //!   owner may read.
@@ -47,6 +49,7 @@ pub mod guard;
 pub mod page;
 pub mod parse;
 pub mod secrets;
+#[cfg(feature = "tls")]
 mod self_signed;
 mod server;
 mod slots;

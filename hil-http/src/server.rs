@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use super::parse::{Progress, RequestParser};
 use super::slots::{Occupancy, Slots, Ticket};
-use super::tls::Tls;
+use super::tls::{ServerConfig as TlsConfig, Tls};
 use super::{Limits, Request, Response, Scheme, Service};
 
 /// How long a client may take to read a response before it is dropped.
@@ -50,6 +50,8 @@ impl Server {
 
     /// As [`start`](Self::start), over HTTPS with `tls`: the same limits,
     /// the request deadline covering the TLS handshake too.
+    // Without the feature `tls` no `Tls` can exist, so this is never called.
+    #[cfg_attr(not(feature = "tls"), allow(unreachable_code))]
     pub fn start_tls(
         addr: SocketAddr,
         service: Arc<dyn Service>,
@@ -63,7 +65,7 @@ impl Server {
         addr: SocketAddr,
         service: Arc<dyn Service>,
         limits: Limits,
-        tls: Option<Arc<rustls::ServerConfig>>,
+        tls: Option<TlsConfig>,
     ) -> std::io::Result<Self> {
         if limits.open_slots == 0 || limits.trusted_slots == 0 || limits.request_deadline.is_zero()
         {
@@ -105,11 +107,9 @@ impl Server {
                             };
                             let conn = match tls {
                                 None => Conn::Plain(socket),
-                                Some(config) => match rustls::ServerConnection::new(config) {
-                                    Ok(c) => {
-                                        Conn::Tls(Box::new(rustls::StreamOwned::new(c, socket)))
-                                    }
-                                    Err(_) => return,
+                                Some(config) => match Conn::tls(config, socket) {
+                                    Some(conn) => conn,
+                                    None => return,
                                 },
                             };
                             serve(conn, ticket, service.as_ref())
@@ -192,30 +192,50 @@ impl Write for Socket {
 /// One client's connection, plain or TLS.
 enum Conn {
     Plain(Socket),
+    #[cfg(feature = "tls")]
     Tls(Box<rustls::StreamOwned<rustls::ServerConnection, Socket>>),
 }
 
 impl Conn {
+    /// A TLS connection over `socket`, or `None` if rustls refuses one.
+    #[cfg(feature = "tls")]
+    fn tls(config: TlsConfig, socket: Socket) -> Option<Self> {
+        let conn = rustls::ServerConnection::new(config).ok()?;
+        Some(Self::Tls(Box::new(rustls::StreamOwned::new(conn, socket))))
+    }
+
+    #[cfg(not(feature = "tls"))]
+    fn tls(config: TlsConfig, _socket: Socket) -> Option<Self> {
+        match config {}
+    }
+
     fn socket(&mut self) -> &mut Socket {
         match self {
             Self::Plain(s) => s,
+            #[cfg(feature = "tls")]
             Self::Tls(t) => &mut t.sock,
         }
     }
 
     fn handshaking(&self) -> bool {
-        matches!(self, Self::Tls(t) if t.conn.is_handshaking())
+        match self {
+            Self::Plain(_) => false,
+            #[cfg(feature = "tls")]
+            Self::Tls(t) => t.conn.is_handshaking(),
+        }
     }
 
     fn scheme(&self) -> Scheme {
         match self {
             Self::Plain(_) => Scheme::Http,
+            #[cfg(feature = "tls")]
             Self::Tls(_) => Scheme::Https,
         }
     }
 
     /// Ends the response: TLS's close_notify, then no more writing.
     fn finish(&mut self) {
+        #[cfg(feature = "tls")]
         if let Self::Tls(t) = self {
             t.conn.send_close_notify();
             while t.conn.wants_write() {
@@ -234,6 +254,7 @@ impl Read for Conn {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         match self {
             Self::Plain(s) => s.read(buf),
+            #[cfg(feature = "tls")]
             Self::Tls(t) => t.read(buf),
         }
     }
@@ -243,6 +264,7 @@ impl Write for Conn {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         match self {
             Self::Plain(s) => s.write(buf),
+            #[cfg(feature = "tls")]
             Self::Tls(t) => t.write(buf),
         }
     }
@@ -250,6 +272,7 @@ impl Write for Conn {
     fn flush(&mut self) -> std::io::Result<()> {
         match self {
             Self::Plain(s) => s.flush(),
+            #[cfg(feature = "tls")]
             Self::Tls(t) => t.flush(),
         }
     }

@@ -351,6 +351,7 @@ impl ServerConfig {
     pub fn validate(&self) -> Result<()> {
         hil_http::guard::check_allowed_hosts(&self.allowed_hosts)?;
         check_seconds("away_after_s", self.away_after_s)?;
+        self.check_https_available()?;
         match (&self.tls_cert, &self.tls_key) {
             (Some(_), None) => Err(HilError::invalid_parameter(
                 "tls_cert",
@@ -365,7 +366,32 @@ impl ServerConfig {
             _ => Ok(()),
         }
     }
+
+    /// Without the feature `https`, a config that asks for HTTPS is an
+    /// error naming the key that asks, never a silent fall back to plain
+    /// HTTP: beyond loopback that would carry the tokens in clear.
+    fn check_https_available(&self) -> Result<()> {
+        if HTTPS || !self.uses_https() {
+            return Ok(());
+        }
+        let (key, value) = if !self.bind.is_loopback() {
+            ("bind", self.bind.to_string())
+        } else if self.https {
+            ("https", "true".to_string())
+        } else {
+            ("tls_cert", "set".to_string())
+        };
+        Err(HilError::invalid_parameter(
+            key,
+            value,
+            "needs HTTPS, which this build leaves out (hil-study's cargo feature `https`): \
+             build `hil` with `--features https` (`scripts/hil study ...` does)",
+        ))
+    }
 }
+
+/// Whether this build serves HTTPS (the cargo feature `https`).
+pub const HTTPS: bool = cfg!(feature = "https");
 
 impl MaterialsConfig {
     /// Checks the pace and the addends (the folder is read when serving).

@@ -176,7 +176,8 @@ impl StudyServer {
     /// participant's log, and starts serving.
     pub fn start(config: StudyConfig, dir: &Path) -> Result<Self> {
         let design = Design::new(config.design.clone())?;
-        config.server.validate()?;
+        // Again: flags (`--lan`, a certificate) change it after loading.
+        config.server.validate().map_err(|e| e.within("server"))?;
         let materials = Materials::load(&config)?;
         std::fs::create_dir_all(dir.join("participants"))
             .map_err(|e| HilError::io("creating", dir, e))?;

@@ -36,6 +36,8 @@ enum StudyCommand {
         /// Listen on every address, for a tablet on the LAN (prints them),
         /// over HTTPS: the lab's certificate (--tls-cert, --tls-key) or a
         /// self-signed one kept in the data folder, its fingerprint printed.
+        /// HTTPS needs a `hil` built with the feature `https` (`bash
+        /// scripts/hil study ...` is).
         #[arg(long)]
         lan: bool,
         /// The lab's certificate chain (PEM) for HTTPS, with --tls-key.

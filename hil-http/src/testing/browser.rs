@@ -89,6 +89,7 @@ impl Browser {
     /// certificate error still stops the page.
     ///
     /// [`Tls::public_key_sha256`]: crate::tls::Tls::public_key_sha256
+    #[cfg(feature = "tls")]
     pub fn start_trusting(public_key_sha256: [u8; 32]) -> Self {
         use base64::Engine;
         let pin = base64::engine::general_purpose::STANDARD.encode(public_key_sha256);

@@ -472,6 +472,7 @@ fn links_and_named_enrolments_survive_a_restart() {
 /// only from the https origin, plain HTTP gets no page, and a restart
 /// keeps the self-signed certificate. Only loopback is used.
 #[test]
+#[cfg(feature = "https")]
 fn https_serves_the_pages_with_a_kept_certificate() {
     use hil_http::testing::client::{get_https, post_https, raw};
     let dir = temp_dir("https");

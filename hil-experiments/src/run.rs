@@ -114,6 +114,18 @@ pub struct Run {
     pub recording: Recording,
 }
 
+/// The refusal of a record key given without a log: there is nothing to
+/// key, and running unrecorded would drop what the caller asked for.
+pub fn key_without_log(key: &RecordKey) -> HilError {
+    HilError::invalid_input(
+        "record key",
+        format!(
+            "a record key ({}) was given but no log to key",
+            key.path().display()
+        ),
+    )
+}
+
 impl Run {
     /// Reads the experiment file `config`, builds it (relative paths
     /// resolve against its directory) and, with `log`, records into a new
@@ -132,13 +144,7 @@ impl Run {
         if log.is_none()
             && let Some(key) = &key
         {
-            return Err(HilError::invalid_input(
-                "record key",
-                format!(
-                    "a record key ({}) was given but no log to key",
-                    key.path().display()
-                ),
-            ));
+            return Err(key_without_log(key));
         }
         let text = hil_core::files::read_text(config, hil_core::files::limits::CONFIG)?;
         let cfg = crate::parse_experiment(&text, config)?;

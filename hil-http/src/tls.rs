@@ -33,7 +33,8 @@ pub const AVAILABLE: bool = cfg!(feature = "tls");
 #[cfg(feature = "tls")]
 pub(crate) type ServerConfig = std::sync::Arc<rustls::ServerConfig>;
 #[cfg(not(feature = "tls"))]
-pub(crate) type ServerConfig = std::convert::Infallible;
+#[derive(Clone)]
+pub(crate) enum ServerConfig {}
 
 /// The self-signed certificate's file in a data folder.
 pub const SELF_SIGNED_CERT: &str = "tls-cert.pem";

@@ -8,9 +8,9 @@
 use std::path::PathBuf;
 
 use hil_core::{EventCollector, HilError, SessionObserver, SessionSettings};
-use hil_experiments::run::{Recording, Run, run_with};
+use hil_experiments::run::{Recording, Run, key_without_log, run_with};
 use hil_experiments::{Experiment, ExperimentSummary};
-use hil_record::Header;
+use hil_record::{Header, RecordKey};
 use pyo3::prelude::*;
 
 use crate::components::{channel_arg, environment_arg, policy_arg, workload_arg};
@@ -54,34 +54,53 @@ fn drive(
     Ok(out)
 }
 
+/// The key file `record_key` names (`hil record keygen` writes one), read
+/// and checked: owner-only, one line of hex, long enough.
+fn read_key(record_key: Option<PathBuf>) -> PyResult<Option<RecordKey>> {
+    record_key
+        .as_deref()
+        .map(RecordKey::read)
+        .transpose()
+        .py_err()
+}
+
 /// Runs the experiment file `config` (TOML, as `hil run --config`) and
 /// returns its summary (the serde form of `ExperimentSummary`: per-episode
 /// metrics, means and standard deviations). With `log`, every step is
 /// recorded in that interaction log (it must not exist yet), so a killed
-/// run continues with `resume(log)`. With `events=True` the summary also
-/// holds every step event.
+/// run continues with `resume(log)`; with `record_key` (a key file, as
+/// `hil run --record-key`) the log is keyed, so an edit is caught even if
+/// its chain is recomputed. With `events=True` the summary also holds
+/// every step event.
 #[pyfunction]
-#[pyo3(signature = (config, *, log=None, events=false))]
+#[pyo3(signature = (config, *, log=None, record_key=None, events=false))]
 pub(crate) fn run(
     py: Python<'_>,
     config: PathBuf,
     log: Option<PathBuf>,
+    record_key: Option<PathBuf>,
     events: bool,
 ) -> PyResult<Py<PyAny>> {
+    let key = read_key(record_key)?;
     let run = py
-        .detach(|| Run::from_config(&config, log.as_deref()))
+        .detach(|| Run::from_config_with_key(&config, log.as_deref(), key))
         .py_err()?;
     drive(py, run.experiment, run.recording, events)
 }
 
 /// Continues the session recorded in `log` by `run(config, log=...)` (after
 /// a crash, a kill or an interrupt): the config comes from the log,
-/// answered queries are not asked again, new steps are appended. Returns
-/// the summary of the whole session.
+/// answered queries are not asked again, new steps are appended. A keyed
+/// log needs its `record_key`. Returns the summary of the whole session.
 #[pyfunction]
-#[pyo3(signature = (log, *, events=false))]
-pub(crate) fn resume(py: Python<'_>, log: PathBuf, events: bool) -> PyResult<Py<PyAny>> {
-    let recording = Recording::open(&log).py_err()?;
+#[pyo3(signature = (log, *, record_key=None, events=false))]
+pub(crate) fn resume(
+    py: Python<'_>,
+    log: PathBuf,
+    record_key: Option<PathBuf>,
+    events: bool,
+) -> PyResult<Py<PyAny>> {
+    let recording = Recording::open_with_key(&log, read_key(record_key)?).py_err()?;
     if recording
         .logged()
         .is_some_and(|l| l.header.config == CODE_SESSION)
@@ -105,9 +124,9 @@ pub(crate) fn resume(py: Python<'_>, log: PathBuf, events: bool) -> PyResult<Py<
 /// perfect expert; `forecast` is the model the policy forecasts with, if
 /// not `workload`. Returns the summary as `run` does. `log` records every
 /// step; `resume=LOG` continues a session so recorded, given the same
-/// components.
+/// components; `record_key` keys the log (or opens a keyed one).
 #[pyfunction]
-#[pyo3(signature = (*, environment, policy, workload, channel=None, forecast=None, episodes=1, seed=0, n_att=10, wl0=0.5, max_items=None, log=None, resume=None, events=false))]
+#[pyo3(signature = (*, environment, policy, workload, channel=None, forecast=None, episodes=1, seed=0, n_att=10, wl0=0.5, max_items=None, log=None, resume=None, record_key=None, events=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn run_session(
     py: Python<'_>,
@@ -123,6 +142,7 @@ pub(crate) fn run_session(
     max_items: Option<usize>,
     log: Option<PathBuf>,
     resume: Option<PathBuf>,
+    record_key: Option<PathBuf>,
     events: bool,
 ) -> PyResult<Py<PyAny>> {
     let settings = SessionSettings::default()
@@ -141,19 +161,32 @@ pub(crate) fn run_session(
         workload: workload_arg(workload)?,
         forecast: forecast.map(workload_arg).transpose()?,
     };
-    let recording = match (log, resume) {
-        (_, Some(path)) => Recording::open(&path),
-        (Some(path), None) => Recording::create(
+    let key = read_key(record_key)?;
+    let recording = match (log, resume, key) {
+        (_, Some(path), key) => Recording::open_with_key(&path, key),
+        (Some(path), None, key) => Recording::create_with_key(
             &path,
             Header::new(CODE_SESSION, "<python>", ".", seed, episodes),
+            key,
         ),
-        (None, None) => Ok(Recording::Off),
+        (None, None, None) => Ok(Recording::Off),
+        (None, None, Some(key)) => Err(key_without_log(&key)),
     }
     .py_err()?;
     drive(py, exp, recording, events)
 }
 
+/// Writes a new random record key to `path` (which must not exist),
+/// readable by its owner only, as `hil record keygen` does: give it as
+/// `record_key` to `run`, `resume` or `run_session`, and keep it apart
+/// from the logs it keys.
+#[pyfunction]
+pub(crate) fn record_keygen(path: PathBuf) -> PyResult<()> {
+    RecordKey::generate(&path).map(drop).py_err()
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(record_keygen, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(resume, m)?)?;
     m.add_function(wrap_pyfunction!(run_session, m)?)?;

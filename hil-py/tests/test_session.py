@@ -148,3 +148,25 @@ def test_the_gil_is_released_while_a_session_runs():
     t.join()
     # Another Python thread kept running while hil's loop ran.
     assert during > 5
+
+
+def test_a_keyed_log_resumes_with_its_key_only(config, tmp_path):
+    key, other = tmp_path / "key.hex", tmp_path / "other.hex"
+    hil.record_keygen(key)
+    hil.record_keygen(other)
+    assert key.stat().st_mode & 0o777 == 0o600
+    with pytest.raises(hil.IoError):
+        hil.record_keygen(key)  # never overwrites a key
+    full_log = tmp_path / "full.jsonl"
+    full = hil.run(config, log=full_log, record_key=key)
+    lines = full_log.read_text().splitlines(keepends=True)
+    cut = tmp_path / "cut.jsonl"
+    cut.write_text("".join(lines[: len(lines) // 2]))
+    for wrong in (None, other):
+        with pytest.raises(hil.DataError) as e:
+            hil.resume(cut, record_key=wrong)
+        assert (e.value.record, e.value.field) == (1, "record_key")
+    assert hil.resume(cut, record_key=key) == full
+    # A key with nothing to key is refused, not ignored.
+    with pytest.raises(hil.InvalidInputError):
+        hil.run(config, record_key=key)

@@ -252,8 +252,11 @@ def select_workload(
 
 # --- sessions and the paper's protocol -----------------------------------------
 
-def run(config: _Path, *, log: Optional[_Path] = None, events: bool = False) -> Dict[str, Any]: ...
-def resume(log: _Path, *, events: bool = False) -> Dict[str, Any]: ...
+def run(
+    config: _Path, *, log: Optional[_Path] = None, record_key: Optional[_Path] = None, events: bool = False
+) -> Dict[str, Any]: ...
+def resume(log: _Path, *, record_key: Optional[_Path] = None, events: bool = False) -> Dict[str, Any]: ...
+def record_keygen(path: _Path) -> None: ...
 def run_session(
     *,
     environment: _EnvironmentLike,
@@ -268,6 +271,7 @@ def run_session(
     max_items: Optional[int] = None,
     log: Optional[_Path] = None,
     resume: Optional[_Path] = None,
+    record_key: Optional[_Path] = None,
     events: bool = False,
 ) -> Dict[str, Any]: ...
 # A Python component for the protocol: a factory (class or function), a

@@ -11,9 +11,9 @@
 //!     en-gb-x-rp,en-029,en-us-nyc,en-gb-x-gbclan 145,180 > tune.jsonl
 //! ```
 
-use hil_speech::audio::{Audio, RECOGNIZER_RATE};
+use hil_speech::SpeechSettings;
 use hil_speech::bench::walk_corpus;
-use hil_speech::endpoint::EndpointSettings;
+use hil_speech::channel::recognizer_input;
 use hil_speech::listen::{Heard, listen};
 use hil_speech::recognize::{DEFAULT_MODEL_DIR, SphinxRecognizer};
 use hil_speech::source::MemoryStream;
@@ -39,24 +39,21 @@ fn main() -> hil_core::Result<()> {
     let rates: Vec<u32> = list(args.next(), "rates");
     let mut recognizer = SphinxRecognizer::new(DEFAULT_MODEL_DIR.as_ref())?;
     let scratch = std::env::temp_dir().join(format!("hil-speech-tune-{}", std::process::id()));
+    let settings = SpeechSettings::default();
     let snrs = [None, Some(20.0), Some(10.0), Some(5.0)];
     // Another stretch of the noise than the bench's (BENCH_NOISE_STRIDE).
     walk_corpus(&voices, &rates, &snrs, 104_729, 5003, &scratch, |u| {
         let (voice, rate, snr) = (&u.voice.voice, u.voice.rate, snrs[u.snr_index]);
         let (phrase, truth) = (u.phrase, u.meaning);
         let mut stream = MemoryStream::new(u.audio);
-        let line = match listen(&mut stream, EndpointSettings::default(), 8.0)? {
+        let line = match listen(&mut stream, settings.endpoint, settings.timeout_s)? {
             Heard::Nothing { .. } => serde_json::json!({
                 "voice": voice, "rate": rate, "phrase": phrase, "snr": snr,
                 "truth": truth, "heard": false,
             }),
             Heard::Utterance(heard) => {
-                let samples = Audio {
-                    rate: RECOGNIZER_RATE,
-                    samples: heard.samples,
-                }
-                .to_i16();
                 let t = std::time::Instant::now();
+                let samples = recognizer_input(&heard, &settings)?;
                 let w = recognizer.weigh(u.grammar, &samples)?;
                 serde_json::json!({
                     "voice": voice, "rate": rate, "phrase": phrase, "snr": snr,

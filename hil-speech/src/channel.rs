@@ -11,7 +11,8 @@ use hil_core::{
 };
 
 use crate::audio::{Audio, RECOGNIZER_RATE};
-use crate::endpoint::EndpointSettings;
+use crate::denoise::{DenoiseSettings, denoise};
+use crate::endpoint::{EndpointSettings, Utterance};
 use crate::grammar::{Grammar, Meaning, REGIONS, spoken_name};
 use crate::listen::{Heard, listen};
 use crate::recognize::{Recognition, Recognizer};
@@ -32,6 +33,9 @@ pub struct SpeechSettings {
     pub max_clipped: f64,
     /// The utterance detector's settings.
     pub endpoint: EndpointSettings,
+    /// The noise reduction before the recognizer (none: the audio as
+    /// heard).
+    pub denoise: Option<DenoiseSettings>,
     /// Where each utterance's WAV and its JSON (transcript, confidence,
     /// timing) are written; none: nothing is kept.
     pub audio_dir: Option<PathBuf>,
@@ -48,6 +52,7 @@ impl Default for SpeechSettings {
             timeout_s: 8.0,
             max_clipped: 0.01,
             endpoint: EndpointSettings::default(),
+            denoise: Some(DenoiseSettings::default()),
             audio_dir: None,
             keep_audio: true,
         }
@@ -294,6 +299,21 @@ pub struct Hearing {
     pub audio: Option<Audio>,
 }
 
+/// What the recognizer hears of an utterance: its samples with the
+/// background measured before it taken out (when the settings ask for it
+/// and there was background to measure), as 16-bit samples.
+pub fn recognizer_input(utterance: &Utterance, settings: &SpeechSettings) -> Result<Vec<i16>> {
+    let samples = match (&settings.denoise, &utterance.background_spectrum) {
+        (Some(d), Some(noise)) => denoise(&utterance.samples, noise, *d)?,
+        _ => utterance.samples.clone(),
+    };
+    Ok(Audio {
+        rate: RECOGNIZER_RATE,
+        samples,
+    }
+    .to_i16())
+}
+
 /// Listens to `stream` once and decides, as the channel does on every
 /// turn (and `hil bench speech` on every utterance of its corpus).
 pub fn hear(
@@ -319,13 +339,13 @@ pub fn hear(
     let decided_at = Instant::now();
     let audio = Audio {
         rate: RECOGNIZER_RATE,
-        samples: utterance.samples,
+        samples: utterance.samples.clone(),
     };
     let clipped = audio.clipped_fraction();
     let (outcome, recognition) = if clipped > settings.max_clipped {
         (Outcome::Clipped, None)
     } else {
-        let r = recognizer.recognize(grammar, &audio.to_i16())?;
+        let r = recognizer.recognize(grammar, &recognizer_input(&utterance, settings)?)?;
         let outcome = match r.meaning {
             Some(_) if r.confidence < settings.threshold => Outcome::Unsure,
             Some(Meaning::Repeat) => Outcome::Repeat,

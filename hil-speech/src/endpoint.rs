@@ -1,6 +1,10 @@
 //! Finding an utterance in a stream of 16 kHz samples: an energy detector
 //! that follows the background's level, so that it works in a quiet room
-//! and next to a running fan alike.
+//! and next to a running fan alike. It also measures the background's
+//! power spectrum, which the noise reduction before the recognizer takes
+//! out ([`crate::denoise`]).
+
+use crate::denoise::{BINS, WINDOW, power_spectrum};
 
 /// Frame length: 10 ms at 16 kHz.
 pub const FRAME: usize = 160;
@@ -50,6 +54,37 @@ pub struct Utterance {
     pub speech_end_s: f64,
     /// Stream time at which the detector closed the utterance.
     pub closed_s: f64,
+    /// The background's mean power spectrum ([`crate::denoise::BINS`]
+    /// bins), from the audio before the utterance's preroll; none when the
+    /// speech started too early to measure it.
+    pub background_spectrum: Option<Vec<f64>>,
+}
+
+/// The mean power spectrum of background frames: a plain mean over the
+/// first `MEAN_FRAMES`, then a running one that follows a changing
+/// background.
+#[derive(Debug, Default)]
+struct BackgroundSpectrum {
+    mean: Vec<f64>,
+    frames: usize,
+}
+
+/// Background frames after which the spectrum's mean becomes a running
+/// mean (over about this many frames).
+const MEAN_FRAMES: usize = 50;
+
+impl BackgroundSpectrum {
+    fn add(&mut self, power: &[f64]) {
+        self.frames += 1;
+        if self.mean.is_empty() {
+            self.mean = power.to_vec();
+            return;
+        }
+        let w = 1.0 / self.frames.min(MEAN_FRAMES) as f64;
+        for (m, p) in self.mean.iter_mut().zip(power) {
+            *m += w * (p - *m);
+        }
+    }
 }
 
 /// Feeds frames, returns the utterance once it is closed.
@@ -62,6 +97,7 @@ pub struct Endpointer {
     history: std::collections::VecDeque<Vec<f32>>,
     run: usize,
     speech: Option<Speech>,
+    spectrum: BackgroundSpectrum,
 }
 
 #[derive(Debug)]
@@ -92,6 +128,7 @@ impl Endpointer {
             history: Default::default(),
             run: 0,
             speech: None,
+            spectrum: BackgroundSpectrum::default(),
         }
     }
 
@@ -132,6 +169,7 @@ impl Endpointer {
             speech_start_s: t(s.start_frame),
             speech_end_s: t(s.last_speech_frame + 1),
             closed_s: t(self.frames_seen),
+            background_spectrum: (self.spectrum.frames > 0).then(|| self.spectrum.mean.clone()),
         }
     }
 
@@ -162,7 +200,18 @@ impl Endpointer {
         self.run = if is_speech { self.run + 1 } else { 0 };
         self.history.push_back(frame);
         while self.history.len() > st.preroll_frames + st.start_frames {
-            self.history.pop_front();
+            // A frame older than the preroll is background: the speech's
+            // onset, softer than the detector's threshold, stays out of
+            // the measured spectrum.
+            let old = self.history.pop_front()?;
+            if let Some(next) = self.history.front() {
+                let mut window = old;
+                window.extend_from_slice(&next[..WINDOW.saturating_sub(FRAME).min(next.len())]);
+                if let Some(power) = power_spectrum(&window) {
+                    debug_assert_eq!(power.len(), BINS);
+                    self.spectrum.add(&power);
+                }
+            }
         }
         if self.run >= st.start_frames {
             let samples: Vec<f32> = self.history.drain(..).flatten().collect();
@@ -181,21 +230,10 @@ impl Endpointer {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn noise(n: usize, amp: f32, seed: u32) -> Vec<f32> {
-        let mut x = seed.max(1);
-        (0..n)
-            .map(|_| {
-                x ^= x << 13;
-                x ^= x >> 17;
-                x ^= x << 5;
-                amp * ((x as f32 / u32::MAX as f32) * 2.0 - 1.0)
-            })
-            .collect()
-    }
+    use crate::test_signals::{noise, tone as tone_at};
 
     fn tone(n: usize, amp: f32) -> Vec<f32> {
-        (0..n).map(|i| amp * (i as f32 * 0.2).sin()).collect()
+        tone_at(n, amp, 0.2)
     }
 
     #[test]
@@ -234,5 +272,41 @@ mod tests {
         let mut ep = Endpointer::new(EndpointSettings::default());
         assert!(ep.push(&noise(32_000, 0.05, 3)).is_none());
         assert!(ep.finish().is_none());
+    }
+
+    #[test]
+    fn the_background_spectrum_is_measured_before_the_speech_and_its_onset() {
+        // 0.6 s of noise, of which the last 0.15 s carry the word's soft
+        // onset (below the detector's threshold), then the word.
+        let mut stream = noise(9600, 0.01, 7);
+        let onset: Vec<f32> = tone(2400, 0.01)
+            .iter()
+            .zip(noise(2400, 0.01, 5))
+            .map(|(a, b)| a + b)
+            .collect();
+        stream.extend(onset);
+        stream.extend(tone(16_000, 0.3));
+        stream.extend(noise(16_000, 0.01, 11));
+        let mut ep = Endpointer::new(EndpointSettings::default());
+        let u = ep.push(&stream).expect("an utterance");
+        let spectrum = u.background_spectrum.expect("background measured");
+        assert_eq!(spectrum.len(), BINS);
+        // The tone (0.2 rad per sample) falls in bin 16 of 512: nothing of
+        // it in the background's spectrum.
+        let mut sorted = spectrum.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted[BINS / 2];
+        assert!(spectrum[16] < 3.0 * median, "{} vs {median}", spectrum[16]);
+    }
+
+    #[test]
+    fn speech_within_the_preroll_of_the_start_has_no_background_measured() {
+        let mut ep = Endpointer::new(EndpointSettings::default());
+        // 50 ms of background: all of it in the utterance's preroll.
+        let mut stream = noise(800, 0.01, 3);
+        stream.extend(tone(16_000, 0.3));
+        stream.extend(vec![0.0; 8000]);
+        let u = ep.push(&stream).expect("an utterance");
+        assert_eq!(u.background_spectrum, None);
     }
 }

@@ -12,6 +12,7 @@ pub mod audio;
 #[cfg(feature = "engines")]
 pub mod bench;
 pub mod channel;
+pub mod denoise;
 pub mod endpoint;
 pub mod grammar;
 pub mod listen;
@@ -21,6 +22,8 @@ pub mod source;
 #[cfg(feature = "engines")]
 pub mod sphinx;
 pub mod stop;
+#[cfg(test)]
+mod test_signals;
 pub mod tts;
 
 pub use channel::{SpeechChannel, SpeechSettings};

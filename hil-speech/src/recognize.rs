@@ -111,8 +111,14 @@ mod engine {
     impl SphinxRecognizer {
         /// Loads the model in `model_dir` (Debian's layout).
         pub fn new(model_dir: &std::path::Path) -> Result<Self> {
+            Self::with_options(model_dir, &[])
+        }
+
+        /// Loads the model with extra pocketsphinx options (pairs such as
+        /// `["-lw", "6.5"]`).
+        pub fn with_options(model_dir: &std::path::Path, options: &[&str]) -> Result<Self> {
             Ok(Self {
-                sphinx: Sphinx::new(&ModelFiles::in_dir(model_dir)?, &[])?,
+                sphinx: Sphinx::new(&ModelFiles::in_dir(model_dir)?, options)?,
             })
         }
 

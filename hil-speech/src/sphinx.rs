@@ -34,6 +34,7 @@ unsafe extern "C" {
     -> c_int;
     fn ps_get_prob(ps: *mut ps_decoder_t) -> i32;
     fn ps_set_search(ps: *mut ps_decoder_t, name: *const c_char) -> c_int;
+    fn ps_start_stream(ps: *mut ps_decoder_t) -> c_int;
     fn ps_start_utt(ps: *mut ps_decoder_t) -> c_int;
     fn ps_process_raw(
         ps: *mut ps_decoder_t,
@@ -246,8 +247,8 @@ impl Sphinx {
     /// history); it restarts from the model's initial mean instead, and
     /// normalises `whole` utterances over their own length (pocketsphinx
     /// switches the mode to running for good once it decodes live).
-    /// (The front end's noise estimate is reset by `ps_start_utt` itself;
-    /// its voice activity detector is off: see `new`.)
+    /// (The front end's noise estimate is reset by `ps_start_stream` in
+    /// `decode_as`; its voice activity detector is off: see `new`.)
     fn forget_history(&mut self, whole: bool) -> Result<()> {
         let (_, mut feat) = self.cmn_state()?;
         // SAFETY: checked layout; the decoder is not decoding now.
@@ -295,7 +296,13 @@ impl Sphinx {
         // utterance. The recognizer decodes both ways and wants agreement.
         // SAFETY: valid decoder; `samples` is a live slice of its length.
         unsafe {
-            if ps_set_search(ps, search.as_ptr()) != 0 || ps_start_utt(ps) != 0 {
+            // A new stream: the front end's noise estimate (`-remove_noise`)
+            // starts afresh; `ps_start_utt` alone keeps it from the
+            // utterances before.
+            if ps_set_search(ps, search.as_ptr()) != 0
+                || ps_start_stream(ps) != 0
+                || ps_start_utt(ps) != 0
+            {
                 return Err(sphinx_error("pocketsphinx could not start an utterance"));
             }
             if ps_process_raw(ps, samples.as_ptr(), samples.len(), 0, c_int::from(whole)) < 0 {

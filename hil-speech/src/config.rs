@@ -22,6 +22,7 @@ use crate::tts::EspeakVoice;
 /// timeout_s = 8.0
 /// audio_dir = "session-audio" # WAV + JSON per utterance (relative to the config)
 /// keep_audio = true           # false: no WAV, only transcripts and timing
+/// denoise = true              # false: the recognizer hears the audio unfiltered
 /// fallback = { type = "terminal" }   # optional; else a decline
 /// ```
 ///
@@ -55,6 +56,11 @@ pub struct SpeechChannelConfig {
     /// Whether WAV files are kept (consent).
     #[serde(default = "yes")]
     pub keep_audio: bool,
+    /// Whether the background noise is filtered out before the recognizer
+    /// ([`crate::denoise`], with its default settings); off, it hears the
+    /// audio as captured (a quiet room, or to compare).
+    #[serde(default = "yes")]
+    pub denoise: bool,
     /// The pocketsphinx model folder (Debian's layout).
     #[serde(default = "default_model")]
     pub model_dir: PathBuf,
@@ -95,6 +101,7 @@ impl SpeechChannelConfig {
             timeout_s: self.timeout_s,
             audio_dir: self.audio_dir.as_ref().map(|d| ctx.base().base_dir.join(d)),
             keep_audio: self.keep_audio,
+            denoise: self.denoise.then(crate::denoise::DenoiseSettings::default),
             ..Default::default()
         }
     }
@@ -218,5 +225,23 @@ mod tests {
                 other => panic!("{text}: {other:?}"),
             }
         }
+    }
+
+    #[test]
+    fn the_noise_filter_is_on_unless_the_config_turns_it_off() {
+        let actions = hil_core::ActionSpace::new(["a", "b"]).unwrap();
+        let ctx = TaskContext::new(hil_config::BuildContext::new(".", 0), actions, 2);
+        let settings = |text: &str| {
+            toml::from_str::<SpeechChannelConfig>(text)
+                .unwrap()
+                .settings(&ctx)
+        };
+        assert_eq!(
+            settings("").denoise,
+            Some(crate::denoise::DenoiseSettings::default())
+        );
+        assert_eq!(settings("denoise = true").denoise, settings("").denoise);
+        assert_eq!(settings("denoise = false").denoise, None);
+        assert!(toml::from_str::<SpeechChannelConfig>("denoise = \"no\"").is_err());
     }
 }

@@ -42,6 +42,8 @@ def speech(
             ``output_device``, ``voice={"voice": "en-us", "rate": 160}``,
             ``threshold`` (least confidence taken as an answer, default
             0.5), ``max_reasks``, ``timeout_s``, ``keep_audio``,
+            ``denoise`` (the noise filter before the recognizer, default
+            True),
             ``model_dir``, ``fallback={"type": "terminal"}``
             (hil-speech's README describes each).
     """

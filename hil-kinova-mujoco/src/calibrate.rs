@@ -873,6 +873,8 @@ mod tests {
                     touched,
                     ..SkewerStats::default()
                 },
+                tines_after_penetration: SkewerStats::default(),
+                tines_after_lift: SkewerStats::default(),
                 push_shift: 0.0,
                 push_tilt: 0.0,
                 counted: touched >= crate::sim::MIN_TINES_TOUCHED,

@@ -138,8 +138,17 @@ pub struct AttemptReport {
     pub stop: StopReason,
     /// Largest axial wrist force during penetration (N).
     pub peak_force: f64,
-    /// Tine counters.
+    /// Tine counters over the whole attempt.
     pub tines: SkewerStats,
+    /// The same counters when penetration ended: with
+    /// [`tines_after_lift`](Self::tines_after_lift) they tell in which
+    /// phase tines tore out or the item slid off (penetration, lift or
+    /// hold), which the attempt log (`hil kinova calibrate --attempts`)
+    /// needs to tell a rim that tears the tines out during the lift from
+    /// an item that creeps off in the hold.
+    pub tines_after_penetration: SkewerStats,
+    /// The counters when the lift ended and the hold began.
+    pub tines_after_lift: SkewerStats,
     /// How far the item moved across the plate (horizontally) from the
     /// pre-pose to the end of penetration (m): an angled push that slides
     /// it away shows here.
@@ -771,6 +780,7 @@ impl Simulator {
         self.check_finite("penetration")?;
         let moved = Vector3::from(self.data.xpos()[b]) - item_at_pre;
         let push_shift = moved.x.hypot(moved.y);
+        let tines_after_penetration = skewer.stats;
         // xmat row-major: element 8 is the z component of the body z axis.
         let push_tilt = self.data.xmat()[b][8].clamp(-1.0, 1.0).acos();
         if let Some(k) = keyframe.as_mut() {
@@ -798,7 +808,8 @@ impl Simulator {
             k("lift", &mut self.data);
         }
         let lifted_height = self.data.xpos()[b][2] - self.plate_top_centre().z;
-        let slip_at_lift = skewer.stats.slip_m;
+        let tines_after_lift = skewer.stats;
+        let slip_at_lift = tines_after_lift.slip_m;
         self.advance(&mut skewer, self.hold, self.free_dt)?;
         self.check_finite("hold")?;
         if let Some(k) = keyframe.as_mut() {
@@ -820,6 +831,8 @@ impl Simulator {
             stop,
             peak_force: peak,
             tines: skewer.stats,
+            tines_after_penetration,
+            tines_after_lift,
             push_shift,
             push_tilt,
             counted: skewer.stats.touched >= MIN_TINES_TOUCHED,

@@ -60,6 +60,31 @@ pub trait EnvironmentConfig: std::fmt::Debug + Send + Sync {
         let _ = ctx;
         Ok(None)
     }
+
+    /// For an environment calibrated to a published table: every item of
+    /// an episode, in order, with the action an expert names for it and
+    /// that action's published success rate where the environment places
+    /// the item. A study reads from it what an always-asking robot can
+    /// score if every attempt succeeds at the published rate
+    /// (`hil_experiments::user_study::PublishedReference`). None (the
+    /// default) for an environment without one.
+    fn published_expert_rates(&self) -> Result<Option<Vec<ExpertRate>>> {
+        Ok(None)
+    }
+}
+
+/// One item's expert action and its published success rate
+/// ([`EnvironmentConfig::published_expert_rates`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ExpertRate {
+    /// The item's label (`banana`).
+    pub item: String,
+    /// The action an expert names for it (`TA0`).
+    pub action: String,
+    /// That action's published success rate per attempt, in [0, 1], where
+    /// the environment places the item (the mean over its settings when it
+    /// draws one at random).
+    pub rate: f64,
 }
 
 /// A serialisable recipe for a [`WorkloadModel`].

@@ -55,7 +55,9 @@ mod field_path;
 pub mod limits;
 mod locate;
 
-pub use component::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
+pub use component::{
+    EnvironmentConfig, ExpertRate, PolicyConfig, QueryChannelConfig, WorkloadModelConfig,
+};
 pub use context::{BuildContext, BuildMemo, TaskContext};
 pub use locate::{error_at_key, error_in_section, parse_toml};
 

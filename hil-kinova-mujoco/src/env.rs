@@ -18,7 +18,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use hil_config::{BuildContext, EnvironmentConfig};
+use hil_config::{BuildContext, EnvironmentConfig, ExpertRate};
 use hil_core::{
     ActionSpace, ArmId, CallOrder, Context, Environment, HilError, Item, LabelledObservation,
     Outcome, Result,
@@ -240,6 +240,33 @@ impl EnvironmentConfig for KinovaFeedingConfig {
         Ok(Some(
             simulated_pretraining(&self.resolved(ctx), ctx.seed)?.into(),
         ))
+    }
+
+    /// The plate's foods with the action the simulated expert names (the
+    /// best published one, [`FoodKind::expert_action`]) and its published
+    /// rate averaged over `settings`, from which every item draws one
+    /// uniformly. The rates are those of the published data set's tool,
+    /// whatever `roll_by` says.
+    fn published_expert_rates(&self) -> Result<Option<Vec<ExpertRate>>> {
+        let settings = self.parsed_settings()?;
+        let rates = self
+            .foods()?
+            .into_iter()
+            .map(|kind| {
+                let a = kind.expert_action();
+                let rate = settings
+                    .iter()
+                    .map(|&s| kind.published_rates_in(s)[a])
+                    .sum::<f64>()
+                    / settings.len() as f64;
+                ExpertRate {
+                    item: kind.name().to_string(),
+                    action: actions()[a].name.to_string(),
+                    rate,
+                }
+            })
+            .collect();
+        Ok(Some(rates))
     }
 }
 
@@ -579,5 +606,51 @@ impl Environment for KinovaFeedingEnv {
 
     fn current_item(&self) -> Option<&Item> {
         self.current.as_ref().map(|c| &c.item)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_expert_rates_are_the_published_ones_where_the_items_lie() {
+        // The paper's study: every item isolated.
+        let isolated = KinovaFeedingConfig {
+            settings: vec!["isolated".into()],
+            ..KinovaFeedingConfig::default()
+        };
+        let rates = isolated.published_expert_rates().unwrap().unwrap();
+        let got: Vec<(&str, &str, f64)> = rates
+            .iter()
+            .map(|r| (r.item.as_str(), r.action.as_str(), r.rate))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("banana", "TA0", 0.2),
+                ("carrot", "VS90", 1.0),
+                ("cantaloupe", "VS90", 1.0)
+            ]
+        );
+        // Every setting: the mean of the three, the published `all` row.
+        let all = KinovaFeedingConfig::default()
+            .published_expert_rates()
+            .unwrap()
+            .unwrap();
+        for r in &all {
+            let kind = FoodKind::parse(&r.item).unwrap();
+            let pooled = kind.published_rates()[kind.expert_action()];
+            assert!((r.rate - pooled).abs() < 0.006, "{r:?} vs {pooled}");
+        }
+        // A bad setting is the config's error, not a silent default.
+        let bad = KinovaFeedingConfig {
+            settings: vec!["table".into()],
+            ..KinovaFeedingConfig::default()
+        };
+        assert!(matches!(
+            bad.published_expert_rates(),
+            Err(HilError::InvalidParameter { .. })
+        ));
     }
 }

@@ -52,6 +52,7 @@
 mod config;
 #[cfg(feature = "physics")]
 mod keyframes;
+mod reference;
 mod run;
 mod seeds;
 pub mod text;
@@ -59,6 +60,7 @@ pub mod text;
 pub use config::{PAPER_WORKLOAD, UserStudyConfig, Validation};
 #[cfg(feature = "physics")]
 pub use keyframes::{Keyframes, PicturedStudy};
+pub use reference::{PlateExpectation, PublishedReference, expected_plate};
 pub use run::{
     Episode, MethodSummary, Plate, PlateResult, Protocol, Selection, UserStudy, UserStudyResult,
     method_order,

@@ -13,6 +13,7 @@ use hil_stats::Stat;
 use serde::Serialize;
 
 use super::config::UserStudyConfig;
+use super::reference::PublishedReference;
 use super::run::{MethodSummary, Protocol, Selection, UserStudyResult};
 use crate::claims::Verdict;
 
@@ -111,6 +112,11 @@ pub struct UserStudyOverSeeds {
     pub differences: Vec<PairedDifference>,
     /// The first seed's protocol.
     pub protocol: Protocol,
+    /// What an always-asking robot scores in expectation at the published
+    /// rates of the actions the expert names, when the environment is
+    /// calibrated to a published table ([`PublishedReference`]): the bound
+    /// a simulated AlwaysQuery is read against.
+    pub published_reference: Option<PublishedReference>,
 }
 
 /// One method's r_task_avg against another's, paired over seeds: every
@@ -234,6 +240,7 @@ impl UserStudyOverSeeds {
             differences: paired_differences(runs),
             selections: runs.iter().map(|r| r.selections.clone()).collect(),
             protocol: first.protocol.clone(),
+            published_reference: None,
         })
     }
 
@@ -289,6 +296,9 @@ impl UserStudyConfig {
             on_seed(seed);
             run
         })?;
-        UserStudyOverSeeds::of(seeds.to_vec(), &runs)
+        let mut over = UserStudyOverSeeds::of(seeds.to_vec(), &runs)?;
+        over.published_reference =
+            PublishedReference::of(self.environment.as_ref(), self.session.n_att)?;
+        Ok(over)
     }
 }

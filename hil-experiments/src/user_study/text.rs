@@ -3,7 +3,7 @@
 
 use std::fmt::{self, Write};
 
-use super::{UserStudyOverSeeds, UserStudyResult};
+use super::{PublishedReference, UserStudyOverSeeds, UserStudyResult};
 
 /// What the results are, printed and kept with them.
 pub const NOTE: &str = "simulation of the user-study protocol; food properties are synthetic, \
@@ -166,6 +166,9 @@ fn write_over_seeds(o: &mut String, over: &UserStudyOverSeeds) -> fmt::Result {
             d.verdict.map_or(String::new(), |v| format!("  {v}"))
         )?;
     }
+    if let Some(r) = &over.published_reference {
+        write_published_reference(o, r)?;
+    }
     writeln!(
         o,
         "where each method asks: queries per plate at each food, and at each attempt index"
@@ -205,4 +208,80 @@ fn write_over_seeds(o: &mut String, over: &UserStudyOverSeeds) -> fmt::Result {
         )?;
     }
     Ok(())
+}
+
+/// The always-asking robot at the published rates, beside the paper's
+/// AlwaysQuery.
+fn write_published_reference(o: &mut String, r: &PublishedReference) -> fmt::Result {
+    let items: Vec<String> = r
+        .items
+        .iter()
+        .map(|i| format!("{} {} {:.2}", i.item, i.action, i.rate))
+        .collect();
+    let e = &r.expected;
+    let paper = hil_paper::user_study::row(hil_paper::methods::PaperMethod::AlwaysQuery).map_or(
+        String::new(),
+        |p| {
+            format!(
+                "; the paper's real AlwaysQuery: {:.2} / {:.2}",
+                p.r_task_avg.mean, p.n_success.mean
+            )
+        },
+    );
+    writeln!(
+        o,
+        "what the published rates allow: asking at every item, with every attempt at the expert's action succeeding at its published rate where the items lie ({}; N_att = {}), a plate scores r_task_avg {:.3} and n_success {:.2} in expectation (exact, not simulated){paper}",
+        items.join(", "),
+        r.n_att,
+        e.r_task_avg,
+        e.n_success,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::user_study::{UserStudyConfig, expected_plate};
+
+    #[test]
+    fn the_page_reads_alwaysquery_against_what_the_published_rates_allow() {
+        let cfg = UserStudyConfig::parse(
+            "repetitions = 1\n[environment]\ntype = \"food_replay\"\nfoods = [\"banana\"]\nitems_per_episode = 2\n[[methods]]\nlabel = \"AlwaysQuery\"\npolicy = { type = \"always_query\", alpha = 0.5 }\n",
+            "study.toml".as_ref(),
+        )
+        .unwrap();
+        let runner = hil_jobs::Runner::new(1).unwrap();
+        let mut over = cfg
+            .run_over_seeds(".".as_ref(), &[3, 4], &runner, &|_| {})
+            .unwrap();
+        // The replay has no published table: no such line.
+        assert_eq!(over.published_reference, None);
+        assert!(!over_seeds_text(&over).contains("what the published rates allow"));
+        let rate = |item: &str, action: &str, rate| hil_config::ExpertRate {
+            item: item.into(),
+            action: action.into(),
+            rate,
+        };
+        over.published_reference = Some(PublishedReference {
+            items: vec![
+                rate("banana", "TA0", 0.2),
+                rate("carrot", "VS90", 1.0),
+                rate("cantaloupe", "VS90", 1.0),
+            ],
+            n_att: 3,
+            expected: expected_plate(&[0.2, 1.0, 1.0], 3).unwrap(),
+        });
+        let text = over_seeds_text(&over);
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("what the published rates allow"))
+            .unwrap_or_else(|| panic!("{text}"));
+        for part in [
+            "banana TA0 0.20, carrot VS90 1.00, cantaloupe VS90 1.00; N_att = 3",
+            "r_task_avg 0.602 and n_success 2.49",
+            "the paper's real AlwaysQuery: 0.87 / 2.68",
+        ] {
+            assert!(line.contains(part), "{part:?} not in {line}");
+        }
+    }
 }

@@ -114,5 +114,8 @@ fn the_report_tells_in_which_phase_the_tines_lost_the_item() {
             lost_in_lift += 1;
         }
     }
-    assert!(lost_in_lift >= 2, "{lost_in_lift} of 3 slid off in the lift");
+    assert!(
+        lost_in_lift >= 2,
+        "{lost_in_lift} of 3 slid off in the lift"
+    );
 }

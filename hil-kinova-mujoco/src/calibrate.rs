@@ -566,6 +566,18 @@ pub struct Consistency {
     /// count is at most a binomial(cells, 0.05) one. Small when the table
     /// differs in many cells, none of them decisively.
     pub p_this_many_below_0_05: f64,
+    /// Every cell below 0.05 with its p-value, most surprising first: what
+    /// still differs from the published table, named.
+    pub cells_below_0_05: Vec<CellP>,
+}
+
+/// One cell's label and p-value ([`Consistency::cells_below_0_05`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CellP {
+    /// The cell (`carrot VS90 lettuce`).
+    pub cell: String,
+    /// Its p-value.
+    pub p: f64,
 }
 
 impl Consistency {
@@ -580,10 +592,21 @@ impl Consistency {
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .cloned()
             .unwrap_or((String::new(), 1.0));
-        let below_0_05 = tested.iter().filter(|(_, p)| *p < 0.05).count();
+        let mut cells_below_0_05: Vec<CellP> = tested
+            .iter()
+            .filter(|(_, p)| *p < 0.05)
+            .map(|(cell, p)| CellP {
+                cell: cell.clone(),
+                p: *p,
+            })
+            .collect();
+        // Stable: equal p-values keep the table's order.
+        cells_below_0_05.sort_by(|a, b| a.p.total_cmp(&b.p));
+        let below_0_05 = cells_below_0_05.len();
         Consistency {
             cells: tested.len(),
             below_0_05,
+            cells_below_0_05,
             p_this_many_below_0_05: binomial_upper_tail(tested.len(), 0.05, below_0_05),
             least_consistent,
             smallest_p,
@@ -1125,6 +1148,12 @@ mod tests {
         assert_eq!(c.cells, 3);
         assert_eq!(c.below_0_05, 2);
         assert_eq!(c.least_consistent, "carrot VS90");
+        let named: Vec<(&str, f64)> = c
+            .cells_below_0_05
+            .iter()
+            .map(|x| (x.cell.as_str(), x.p))
+            .collect();
+        assert_eq!(named, [("carrot VS90", 0.01), ("banana TA0", 0.04)]);
         assert_eq!(c.smallest_p, 0.01);
         assert!((c.smallest_p_adjusted - 0.03).abs() < 1e-12);
         // Two or more of three cells below 0.05 by chance: 3·0.05²·0.95 + 0.05³.

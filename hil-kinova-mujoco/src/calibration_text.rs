@@ -141,15 +141,24 @@ fn write_consistency(o: &mut String, what: &str, c: &Consistency) -> fmt::Result
         c.smallest_p_adjusted,
         c.cells
     )?;
+    if !c.cells_below_0_05.is_empty() {
+        let named: Vec<String> = c
+            .cells_below_0_05
+            .iter()
+            .map(|x| format!("{} ({:.3})", x.cell, x.p))
+            .collect();
+        writeln!(o, "  below p = 0.05, {what}: {}", named.join(", "))?;
+    }
     Ok(())
 }
 
 fn write_throughput(o: &mut String, report: &CalibrationReport) -> fmt::Result {
     writeln!(
         o,
-        "{:.1} attempts/s on {} threads ({:.1} per core); {:.0} steps per attempt at {:.1} µs per mj_step; {:.1}% of time outside mj_step",
+        "{:.1} attempts/s on {} thread{} ({:.1} per core); {:.0} steps per attempt at {:.1} µs per mj_step; {:.1}% of time outside mj_step",
         report.attempts_per_second,
         report.threads,
+        if report.threads == 1 { "" } else { "s" },
         report.attempts_per_second_per_core,
         report.steps_per_attempt,
         report.micros_per_step,

@@ -63,7 +63,7 @@ pub use attempt_log::AttemptLog;
 #[cfg(feature = "physics")]
 pub use calibrate::{
     AttemptRecord, CalibrationOptions, CalibrationOverSeeds, CalibrationReport, CalibrationRow,
-    CalibrationTarget, Consistency, SettingCell, TARGET_GRID, Tally, calibrate,
+    CalibrationTarget, CellP, Consistency, SettingCell, TARGET_GRID, Tally, calibrate,
     calibrate_over_seeds, calibrate_with, expected_abs_error_of_a_perfect_simulator,
 };
 #[cfg(feature = "physics")]

@@ -86,6 +86,16 @@ fn calibrate_prints_rates_beside_the_published_ones() {
         "{c}"
     );
     assert!(v["consistency_by_setting"]["cells"].as_u64().unwrap() <= 18);
+    // Every cell below 0.05 is named with its p-value, most surprising first.
+    let named: Vec<f64> = c["cells_below_0_05"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["p"].as_f64().unwrap())
+        .collect();
+    assert_eq!(named.len() as u64, c["below_0_05"].as_u64().unwrap());
+    assert_eq!(named.len(), p_values.iter().filter(|&&p| p < 0.05).count());
+    assert!(named.windows(2).all(|w| w[0] <= w[1]), "{named:?}");
 
     // Two seeds: each run as the seed alone, their attempts pooled.
     let v = calibrate_carrot_json(&["--seeds", "2", "--seed", "7"]);

@@ -10,13 +10,15 @@
 //!
 //! | limit | value | applies to |
 //! |---|---|---|
-//! | [`EPISODES`] | 100 000 | `episodes` of an experiment |
+//! | [`EPISODES`] | 100 000 | `episodes` of an experiment, `repetitions` and validation `plates` of a user study |
 //! | [`ITEMS_PER_EPISODE`] | 100 000 | `items_per_episode`, `session.max_items`, a demo plate's `foods` × `repeat` |
 //! | [`ATTEMPTS_PER_ITEM`] | 1 000 | `session.n_att` |
 //! | [`WINDOW`] | 1 000 000 | a workload model's `window` (timesteps) |
 //! | [`PARTICIPANTS`] | 10 000 | each participant count of a synthetic study |
 //! | [`SURVEYS`] | 1 000 000 | a count of surveys of a synthetic study |
 //! | [`SECONDS`] | 86 400 | a simulated time in seconds (a day) |
+//! | [`SEEDS`] | 10 000 | seeds one run sweeps: a protocol's environment and policy seeds, `--seeds` of `hil kinova calibrate` and `hil demo kinova` |
+//! | [`TRIALS`] | 1 000 000 | trials per food and action of a simulated calibration (`--trials`) |
 //!
 //! Component crates call [`check_count`] (a count that must be at least 1)
 //! or [`check_at_most`] (one that may be 0) from their config's
@@ -56,6 +58,38 @@ pub const SURVEYS: u64 = 1_000_000;
 /// Longest simulated duration in seconds (one day), e.g. a simulated
 /// expert's median response time.
 pub const SECONDS: f64 = 86_400.0;
+
+/// Most seeds one run sweeps: a protocol's environment or policy seeds, or
+/// the consecutive master seeds of a run over seeds ([`consecutive_seeds`]).
+pub const SEEDS: u64 = 10_000;
+
+/// Most trials per food and action of a simulated calibration: at the
+/// limit, the three calibrated foods take 18 million attempts (days on a
+/// workstation), and the job list still fits in memory.
+pub const TRIALS: u64 = 1_000_000;
+
+/// The `n` consecutive master seeds `first`, `first + 1`, ... of a run over
+/// seeds (wrapping past `u64::MAX` to 0), after checking that `n`, the
+/// field or flag `name`, is in `1..=`[`SEEDS`]: a typo of 20 digits is an
+/// error naming the flag, not an allocation failure.
+///
+/// ```
+/// use hil_config::limits::consecutive_seeds;
+/// assert_eq!(consecutive_seeds("--seeds", 9001, 3)?, [9001, 9002, 9003]);
+/// assert_eq!(consecutive_seeds("--seeds", u64::MAX, 2)?, [u64::MAX, 0]);
+/// assert!(consecutive_seeds("--seeds", 1, 0).is_err());
+/// assert!(consecutive_seeds("--seeds", 1, u64::MAX).is_err());
+/// # Ok::<(), hil_core::HilError>(())
+/// ```
+pub fn consecutive_seeds<T>(name: &str, first: u64, n: T) -> Result<Vec<u64>>
+where
+    T: TryInto<u64> + std::fmt::Display + Copy,
+{
+    check_count(name, n, SEEDS)?;
+    // Checked above: n fits in u64 and is at most SEEDS.
+    let n: u64 = n.try_into().unwrap_or(0);
+    Ok((0..n).map(|i| first.wrapping_add(i)).collect())
+}
 
 /// Checks that the count `value` of the field `name` is in `1..=max`.
 ///

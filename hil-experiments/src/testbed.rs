@@ -94,9 +94,6 @@ fn default_grid_name() -> String {
     "default".into()
 }
 
-/// Most environment or policy seeds a protocol may ask for.
-pub const MAX_SEEDS: u64 = 10_000;
-
 /// Everything that defines a protocol run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -313,17 +310,17 @@ impl ProtocolSettings {
     }
 
     /// Checks every count against its stated limit
-    /// ([`hil_config::limits`]; seeds: at most [`MAX_SEEDS`]).
+    /// ([`hil_config::limits`]; seeds: at most [`hil_config::limits::SEEDS`]).
     pub fn check_counts(&self) -> Result<()> {
-        use hil_config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
+        use hil_config::limits::{ITEMS_PER_EPISODE, SEEDS, check_at_most, check_count};
         check_count(
             "items_per_episode",
             self.items_per_episode,
             ITEMS_PER_EPISODE,
         )?;
-        check_count("n_seeds", self.n_seeds, MAX_SEEDS)?;
-        check_at_most("many_seeds", self.many_seeds, MAX_SEEDS)?;
-        check_count("n_policy_seeds", self.n_policy_seeds, MAX_SEEDS)?;
+        check_count("n_seeds", self.n_seeds, SEEDS)?;
+        check_at_most("many_seeds", self.many_seeds, SEEDS)?;
+        check_count("n_policy_seeds", self.n_policy_seeds, SEEDS)?;
         Ok(())
     }
 

@@ -234,6 +234,7 @@ pub fn calibrate_with(
             "needs at least one of each",
         ));
     }
+    hil_config::limits::check_count("trials", opts.trials, hil_config::limits::TRIALS)?;
     let start = Instant::now();
     let jobs: Vec<(FoodKind, usize, usize)> = opts
         .foods
@@ -875,6 +876,24 @@ mod tests {
     use super::*;
     use crate::sim::StopReason;
     use crate::skewer::SkewerStats;
+
+    /// Trial counts outside `1..=limits::TRIALS` are refused before the
+    /// job list is built (a 20-digit count was a capacity overflow).
+    #[test]
+    fn trial_counts_outside_the_limit_are_refused() {
+        let quiet = |_: usize, _: usize| {};
+        for trials in [0, hil_config::limits::TRIALS as usize + 1, usize::MAX] {
+            let opts = CalibrationOptions {
+                trials,
+                ..CalibrationOptions::default()
+            };
+            let err = calibrate_with(&opts, &quiet, &mut |_| {}).unwrap_err();
+            assert!(
+                matches!(err, HilError::InvalidParameter { .. }),
+                "{trials}: {err}"
+            );
+        }
+    }
 
     fn record(setting: Setting, touched: usize, success: bool) -> AttemptRecord {
         AttemptRecord {

@@ -59,7 +59,7 @@ pub(crate) fn user_study(
         }
         Some(n) => {
             let runner = Runner::new(threads).py_err()?;
-            let seeds: Vec<u64> = (0..n as u64).map(|i| cfg.seed.wrapping_add(i)).collect();
+            let seeds = hil_config::limits::consecutive_seeds("seeds", cfg.seed, n).py_err()?;
             let over = py
                 .detach(|| cfg.run_over_seeds(&base, &seeds, &runner, &|_| {}))
                 .py_err()?;

@@ -79,6 +79,11 @@ def test_bad_input_names_its_field():
     assert "repetitions" in str(e.value)
     with pytest.raises(hil.InvalidInputError):
         hil.user_study(environment=FOODS, repetitions=0)
+    # A run over seeds takes between 1 and 10,000 of them.
+    for seeds in (0, 10_001):
+        with pytest.raises(hil.InvalidParameterError) as e:
+            hil.user_study(environment=FOODS, seeds=seeds)
+        assert "seeds" in str(e.value)
 
 
 @pytest.mark.skipif(hil.KINOVA, reason="this build has the MuJoCo scene")

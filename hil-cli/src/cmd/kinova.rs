@@ -16,6 +16,7 @@
 use crate::out::{note, outln};
 use std::path::{Path, PathBuf};
 
+use hil_config::limits;
 use hil_core::{HilError, Result};
 use hil_experiments::user_study::text::{NOTE, over_seeds_text, result_text};
 use hil_experiments::user_study::{Plate, UserStudyConfig};
@@ -174,20 +175,8 @@ fn labels_or_all<T: Label>(flag: &str, given: &[String]) -> Result<Vec<T>> {
 }
 
 fn calibrate(args: CalibrateArgs) -> Result<()> {
-    if args.trials == 0 {
-        return Err(HilError::invalid_parameter(
-            "--trials",
-            "0",
-            "must be at least 1",
-        ));
-    }
-    if args.seeds == 0 {
-        return Err(HilError::invalid_parameter(
-            "--seeds",
-            "0",
-            "must be at least 1",
-        ));
-    }
+    limits::check_count("--trials", args.trials, limits::TRIALS)?;
+    let seeds = limits::consecutive_seeds("--seeds", args.seed, args.seeds)?;
     let roll_by = RollBy::parse(&args.roll_by).ok_or_else(|| {
         HilError::invalid_parameter(
             "--roll-by",
@@ -228,7 +217,6 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         .as_deref()
         .map(AttemptLog::create)
         .transpose()?;
-    let seeds: Vec<u64> = (0..args.seeds).map(|i| args.seed.wrapping_add(i)).collect();
     let mut records = Vec::new();
     let mut over = calibrate_over_seeds(&opts, &seeds, &progress, &mut |r| {
         if log.is_some() {
@@ -279,13 +267,12 @@ fn components_dir(args: &KinovaDemoArgs) -> PathBuf {
 }
 
 fn demo_config(args: &KinovaDemoArgs) -> Result<UserStudyConfig> {
-    for (flag, zero) in [
-        ("--repetitions", args.repetitions == Some(0)),
-        ("--n-att", args.n_att == Some(0)),
-    ] {
-        if zero {
-            return Err(HilError::invalid_parameter(flag, 0, "must be at least 1"));
-        }
+    // The flags are checked here, so that a bad value names the flag.
+    if let Some(r) = args.repetitions {
+        limits::check_count("--repetitions", r, limits::EPISODES)?;
+    }
+    if let Some(n) = args.n_att {
+        limits::check_count("--n-att", n, limits::ATTEMPTS_PER_ITEM)?;
     }
     let mut cfg = match &args.components {
         Some(path) => UserStudyConfig::load(path)?,
@@ -305,13 +292,7 @@ fn demo_config(args: &KinovaDemoArgs) -> Result<UserStudyConfig> {
 }
 
 fn demo_kinova(args: KinovaDemoArgs) -> Result<()> {
-    if args.seeds == 0 {
-        return Err(HilError::invalid_parameter(
-            "--seeds",
-            0,
-            "must be at least 1",
-        ));
-    }
+    limits::check_count("--seeds", args.seeds, limits::SEEDS)?;
     if args.seeds > 1 {
         return demo_many_seeds(&args);
     }
@@ -378,10 +359,7 @@ fn demo_many_seeds(args: &KinovaDemoArgs) -> Result<()> {
         ));
     }
     let cfg = demo_config(args)?;
-    let first = cfg.seed;
-    let seeds: Vec<u64> = (0..args.seeds as u64)
-        .map(|i| first.wrapping_add(i))
-        .collect();
+    let seeds = limits::consecutive_seeds("--seeds", cfg.seed, args.seeds)?;
     let quiet = args.quiet;
     let over = cfg.run_over_seeds(
         &components_dir(args),

@@ -116,16 +116,29 @@ fn calibrate_prints_rates_beside_the_published_ones() {
         .collect();
     let mean = v["mean_abs_error"]["mean"].as_f64().unwrap();
     assert!((mean - (means[0] + means[1]) / 2.0).abs() < 1e-12);
-    let out = hil(&["kinova", "calibrate", "--seeds", "0"]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--seeds"));
-
     let out = hil(&["kinova", "calibrate", "--foods", "apple"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("apple"));
     let out = hil(&["kinova", "calibrate", "--settings", "bowl"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("bowl"));
+}
+
+/// Counts outside their limits (`hil_config::limits`) are refused before
+/// anything runs or is allocated, naming the flag.
+#[test]
+fn calibrate_refuses_counts_outside_their_limits() {
+    for (flag, value) in [
+        ("--seeds", "0"),
+        ("--seeds", "18446744073709551615"),
+        ("--trials", "18446744073709551615"),
+    ] {
+        let out = hil(&["kinova", "calibrate", flag, value]);
+        assert!(!out.status.success(), "{flag} {value}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(flag), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
 }
 
 #[test]
@@ -255,7 +268,16 @@ fn errors_in_a_study_file_name_file_line_and_field() {
     assert!(stderr.contains(&format!("{path}:1:")), "{stderr}");
     assert!(stderr.contains("polcy"), "{stderr}");
 
-    let out = hil(&["demo", "kinova", "--repetitions", "0"]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--repetitions"));
+    for (flag, value) in [
+        ("--repetitions", "0"),
+        ("--repetitions", "18446744073709551615"),
+        ("--n-att", "1001"),
+        ("--seeds", "18446744073709551615"),
+    ] {
+        let out = hil(&["demo", "kinova", flag, value]);
+        assert!(!out.status.success(), "{flag} {value}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(flag), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
 }

@@ -275,12 +275,11 @@ impl UserStudyConfig {
         self.session
             .validate()
             .map_err(|e| hil_config::error_at_key(text, path, &["session"], e.to_string()))?;
-        if self.repetitions == 0 {
-            return Err(at(&["repetitions"], "must be at least 1"));
-        }
-        if self.validation.plates == 0 {
-            return Err(at(&["validation", "plates"], "must be at least 1"));
-        }
+        use hil_config::limits::{EPISODES, check_count};
+        check_count("repetitions", self.repetitions, EPISODES)
+            .map_err(|e| at(&["repetitions"], &e.to_string()))?;
+        check_count("plates", self.validation.plates, EPISODES)
+            .map_err(|e| at(&["validation", "plates"], &e.to_string()))?;
         if !(0.0..=1.0).contains(&self.validation.w_task) {
             return Err(at(&["validation", "w_task"], "must be in [0, 1]"));
         }

@@ -147,6 +147,11 @@ fn unknown_policy_type_is_located() {
 fn counts_are_validated() {
     let err = parse("seed = 1\nrepetitions = 0\n").unwrap_err();
     assert_eq!(located(&err), (2, Some("repetitions")));
+    // A count above its limit is refused before anything is allocated.
+    let err = parse("repetitions = 100001\n").unwrap_err();
+    assert_eq!(located(&err), (1, Some("repetitions")));
+    let err = parse("[validation]\nplates = 9223372036854775807\n").unwrap_err();
+    assert_eq!(located(&err), (2, Some("validation.plates")));
 
     let err = parse("methods = []\n").unwrap_err();
     assert_eq!(located(&err), (1, Some("methods")));

@@ -18,6 +18,7 @@
 //! | [`SURVEYS`] | 1 000 000 | a count of surveys of a synthetic study |
 //! | [`SECONDS`] | 86 400 | a simulated time in seconds (a day) |
 //! | [`SEEDS`] | 10 000 | seeds one run sweeps: a protocol's environment and policy seeds, `--seeds` of `hil kinova calibrate` and `hil demo kinova` |
+//! | [`TIMESTEPS`] | 1 000 000 | the last timestep of a workload rollout and of its query schedule |
 //! | [`TRIALS`] | 1 000 000 | trials per food and action of a simulated calibration (`--trials`) |
 //!
 //! Component crates call [`check_count`] (a count that must be at least 1)
@@ -62,6 +63,10 @@ pub const SECONDS: f64 = 86_400.0;
 /// Most seeds one run sweeps: a protocol's environment or policy seeds, or
 /// the consecutive master seeds of a run over seeds ([`consecutive_seeds`]).
 pub const SEEDS: u64 = 10_000;
+
+/// Latest timestep a workload rollout reaches, and so its query schedule
+/// (Δt = 10 s: about 116 days).
+pub const TIMESTEPS: u64 = 1_000_000;
 
 /// Most trials per food and action of a simulated calibration: at the
 /// limit, the three calibrated foods take 18 million attempts (days on a

@@ -17,7 +17,7 @@ pub struct RolloutStep {
 
 /// `model`'s workload at every timestep `0..=end` from `wl0`, the queries
 /// of `schedule` (timesteps not decreasing) entering the history at their
-/// timesteps.
+/// timesteps. `end` is at most [`hil_config::limits::TIMESTEPS`].
 ///
 /// ```
 /// use hil_core::QueryKind;
@@ -35,6 +35,7 @@ pub fn rollout(
     end: Timestep,
 ) -> Result<Vec<RolloutStep>> {
     hil_core::workload::check_wl0(wl0)?;
+    hil_config::limits::check_at_most("steps", end, hil_config::limits::TIMESTEPS)?;
     let mut history = QueryHistory::new();
     let mut steps = Vec::new();
     let mut next = 0;
@@ -73,6 +74,12 @@ pub fn parse_schedule(s: &str) -> Result<Vec<(Timestep, QueryKind)>> {
             .trim()
             .parse()
             .map_err(|_| bad(format!("`{t}` is not a timestep (non-negative integer)")))?;
+        if t > hil_config::limits::TIMESTEPS {
+            return Err(bad(format!(
+                "timestep {t} is past the last one a rollout reaches ({})",
+                hil_config::limits::TIMESTEPS
+            )));
+        }
         let k: QueryKind = if kind.trim().is_empty() {
             QueryKind::default()
         } else {
@@ -109,6 +116,22 @@ mod tests {
                 .contains("telepathy")
         );
         assert!(parse_schedule("5,3").is_err());
+        // A timestep past the limit is refused by name (its `+ 10` for the
+        // default end wrapped around before).
+        let err = parse_schedule("1,18446744073709551615").unwrap_err();
+        assert!(
+            matches!(err, HilError::InvalidParameter { ref name, .. } if name == "schedule[1]"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_rollout_past_the_limit_is_refused() {
+        let model = crate::bundled::load("f12_sim").unwrap();
+        let err = rollout(model.as_ref(), 0.5, &[], u64::MAX).unwrap_err();
+        assert!(matches!(err, HilError::InvalidParameter { ref name, .. } if name == "steps"));
+        let last = hil_config::limits::TIMESTEPS;
+        assert!(rollout(model.as_ref(), 0.5, &[], last + 1).is_err());
     }
 
     #[test]

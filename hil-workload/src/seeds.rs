@@ -86,8 +86,12 @@ pub struct SeedSpread {
 
 impl SeedSpread {
     /// Generates one study per seed in `seeds` (in parallel on the default
-    /// [`hil_jobs::Runner`]).
+    /// [`hil_jobs::Runner`]); `seeds` holds 1 to
+    /// [`hil_config::limits::SEEDS`] of them.
     pub fn over(config: &SynthConfig, seeds: Range<u64>) -> Result<Self> {
+        // Checked before the list is built (`hil_config::limits::SEEDS`).
+        let n = seeds.end.saturating_sub(seeds.start);
+        hil_config::limits::check_count("seeds", n, hil_config::limits::SEEDS)?;
         let seeds: Vec<u64> = seeds.collect();
         let draws: Vec<Draw> = hil_jobs::Runner::default().map(&seeds, |&s| Draw::of(config, s))?;
         let col = |f: &dyn Fn(&Draw) -> f64| Stat::of(&draws.iter().map(f).collect::<Vec<_>>());

@@ -305,6 +305,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             centre,
             write_doc,
         } => {
+            hil_config::limits::check_count("--count", count, hil_config::limits::SEEDS)?;
             let cfg = synth_config(config.as_deref())?;
             let t0 = Instant::now();
             let mut report = if centre {

@@ -10,6 +10,7 @@ mod study;
 mod bench;
 mod cli;
 mod closed_pipes;
+mod count_limits;
 mod data_inputs;
 #[cfg(feature = "physics")]
 mod kinova;

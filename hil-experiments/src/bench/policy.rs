@@ -146,18 +146,67 @@ impl WorkloadModel for PerQuery {
 /// Default length of the bandwidth probe: 256 MiB.
 const PROBE_BYTES: usize = 256 << 20;
 
+/// Most context dimensions a policy benchmark takes (the paper's features
+/// have 2048).
+pub const MAX_DIM: u64 = 8192;
+/// Most arms a policy benchmark takes.
+pub const MAX_ARMS: u64 = 1024;
+/// Most pretraining rounds a policy benchmark takes.
+pub const MAX_PRETRAIN: u64 = 1_000_000;
+/// Most timed steps a policy benchmark takes.
+pub const MAX_STEPS: u64 = 10_000_000;
+/// Most numbers one kind of per-arm state (arms × dim², a d × d matrix per
+/// arm) or the synthetic pretraining data (rounds × arms × dim) may hold:
+/// 2 GiB of `f64` each.
+pub const MAX_VALUES: u64 = 1 << 28;
+
 impl PolicyBench {
+    /// Checks every size against its limit before anything is allocated,
+    /// naming the flag: a 20-digit `--dim` is an error, not a capacity
+    /// overflow.
+    fn check_sizes(&self) -> Result<()> {
+        use hil_config::limits::{check_at_most, check_count};
+        check_count("--dim", self.dim, MAX_DIM)?;
+        check_count("--arms", self.arms, MAX_ARMS)?;
+        check_count("--steps", self.steps, MAX_STEPS)?;
+        check_at_most("--pretrain", self.pretrain, MAX_PRETRAIN)?;
+        // Each factor is bounded above, so the products cannot overflow.
+        let (dim, arms, pretrain) = (self.dim as u64, self.arms as u64, self.pretrain as u64);
+        let too_many = |flag: &str, value: u64, what: String, values: u64| {
+            HilError::invalid_parameter(
+                flag,
+                value,
+                format!(
+                    "{what} is {values} numbers, at most {MAX_VALUES} (2 GiB): \
+                     lower --arms or --dim{}",
+                    if flag == "--pretrain" {
+                        " or --pretrain"
+                    } else {
+                        ""
+                    }
+                ),
+            )
+        };
+        let state = arms * dim * dim;
+        if state > MAX_VALUES {
+            let what = format!("a {dim} × {dim} matrix for each of {arms} arms");
+            return Err(too_many("--dim", dim, what, state));
+        }
+        let data = pretrain * arms * dim;
+        if data > MAX_VALUES {
+            let what =
+                format!("{pretrain} rounds × {arms} arms × dimension {dim} of pretraining data");
+            return Err(too_many("--pretrain", pretrain, what, data));
+        }
+        Ok(())
+    }
+
     /// Builds the policy on synthetic pretraining data, then times `steps`
     /// decide + observe calls (after 3 warm-up steps), sampling the read
     /// bandwidth every 20 steps so that the floor sees the same machine
     /// load as the steps do.
     pub fn run(&self) -> Result<PolicyBenchReport> {
-        if self.steps == 0 || self.arms == 0 || self.dim == 0 {
-            return Err(HilError::invalid_input(
-                "bench arguments",
-                "--steps, --arms and --dim must be at least 1",
-            ));
-        }
+        self.check_sizes()?;
         let table = self.spec.table()?;
         // Before the data are drawn: a bad setting fails at once.
         let config = spec::parse(&table)?;
@@ -475,6 +524,32 @@ mod tests {
             seed: 1,
             probe_bytes: 1 << 16,
             ..Default::default()
+        }
+    }
+
+    /// Every size outside its limit is refused, naming its flag.
+    #[test]
+    fn sizes_outside_their_limits_name_the_flag() {
+        type Set = fn(&mut PolicyBench);
+        let cases: [(&str, Set); 7] = [
+            ("--dim", |b| b.dim = 0),
+            ("--dim", |b| b.dim = usize::MAX),
+            ("--arms", |b| b.arms = usize::MAX),
+            ("--steps", |b| b.steps = usize::MAX),
+            ("--pretrain", |b| b.pretrain = usize::MAX),
+            ("--pretrain", |b| {
+                (b.pretrain, b.arms, b.dim) = (1_000_000, 256, 1024);
+            }),
+            ("--dim", |b| (b.arms, b.dim) = (1024, 8192)),
+        ];
+        for (flag, set) in cases {
+            let mut b = small("linucb");
+            set(&mut b);
+            let err = b.run().unwrap_err();
+            assert!(
+                matches!(err, HilError::InvalidParameter { ref name, .. } if name == flag),
+                "{flag}: {err}"
+            );
         }
     }
 

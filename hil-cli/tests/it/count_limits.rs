@@ -1,0 +1,51 @@
+//! A count flag given a value outside its limit (`hil_config::limits`, or
+//! the benchmark's own) is refused before anything is allocated or run,
+//! with an error naming the flag: a 20-digit count was a capacity-overflow
+//! panic, and a schedule's last timestep + 10 wrapped around to a short,
+//! wrong rollout.
+
+use crate::common::hil;
+
+const HUGE: &str = "18446744073709551615";
+
+fn refused(args: &[&str], names: &str) {
+    let out = hil(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert!(stderr.contains(names), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+}
+
+#[test]
+fn counts_outside_their_limits_name_the_flag() {
+    refused(&["workload", "seeds", "--count", HUGE], "--count");
+    refused(&["workload", "seeds", "--count", "0"], "--count");
+    for flag in ["--dim", "--arms", "--steps", "--pretrain"] {
+        refused(&["bench", "policy", "--policy", "linucb", flag, HUGE], flag);
+    }
+    let model = "bundled:f1_sim";
+    refused(
+        &[
+            "workload",
+            "rollout",
+            "--model",
+            model,
+            "--schedule",
+            "3",
+            "--steps",
+            HUGE,
+        ],
+        "steps",
+    );
+    refused(
+        &[
+            "workload",
+            "rollout",
+            "--model",
+            model,
+            "--schedule",
+            &format!("3,{HUGE}"),
+        ],
+        "schedule[1]",
+    );
+}

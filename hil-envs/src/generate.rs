@@ -201,13 +201,12 @@ impl SyntheticFoods {
                 "must be in [0, 1]",
             ));
         }
-        if self.images_per_setting < 1 {
-            return Err(HilError::invalid_parameter(
-                "images_per_setting",
-                self.images_per_setting,
-                "must be at least 1",
-            ));
-        }
+        // Each food's contexts are one `.npy` array, which the loader reads
+        // only up to npy::MAX_ELEMENTS: a dataset past that could not be
+        // read back (and a 20-digit size overflowed the allocation).
+        let max = crate::npy::MAX_ELEMENTS as u64;
+        hil_config::limits::check_count("images_per_setting", self.images_per_setting, max)?;
+        hil_config::limits::check_count("dim", self.dim, max)?;
         Ok(())
     }
 
@@ -230,6 +229,21 @@ impl SyntheticFoods {
                 "dim",
                 self.dim,
                 format!("must be at least {k} (the latent size for {n_f} foods)"),
+            ));
+        }
+        // Both factors are at most MAX_ELEMENTS (validate), so no overflow.
+        let per_food = (n_s * self.images_per_setting) as u64 * self.dim as u64;
+        if per_food > crate::npy::MAX_ELEMENTS as u64 {
+            return Err(HilError::invalid_parameter(
+                "dim",
+                self.dim,
+                format!(
+                    "{n_s} settings × {} images × dimension {} is {per_food} numbers per food, \
+                     more than a dataset array may hold ({}): lower dim or images_per_setting",
+                    self.images_per_setting,
+                    self.dim,
+                    crate::npy::MAX_ELEMENTS
+                ),
             ));
         }
         let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
@@ -450,6 +464,39 @@ mod tests {
             }
             .generate()
             .is_err()
+        );
+        // Sizes the loader could not read back are refused by name, before
+        // anything is allocated.
+        let named = |g: SyntheticFoods, field: &str| {
+            let err = g.generate().unwrap_err();
+            assert!(
+                matches!(err, HilError::InvalidParameter { ref name, .. } if name == field),
+                "{field}: {err}"
+            );
+        };
+        named(
+            SyntheticFoods {
+                dim: usize::MAX,
+                ..small()
+            },
+            "dim",
+        );
+        let images = usize::MAX;
+        named(
+            SyntheticFoods {
+                images_per_setting: images,
+                ..small()
+            },
+            "images_per_setting",
+        );
+        let images = 1 << 20;
+        named(
+            SyntheticFoods {
+                images_per_setting: images,
+                dim: 1024,
+                ..small()
+            },
+            "dim",
         );
     }
 }

@@ -218,6 +218,7 @@ pub fn run(
     settings: &BenchSettings,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Vec<BenchRow>> {
+    settings.channel.validate()?;
     let mut recognizer = SphinxRecognizer::new(&settings.model_dir)?;
     let total = corpus_items().len()
         * settings.voices.len()

@@ -44,6 +44,52 @@ pub struct SpeechSettings {
     pub keep_audio: bool,
 }
 
+impl SpeechSettings {
+    /// Checks the settings a config or a caller may set: the threshold is
+    /// in [0, 1], the timeout in (0, 600] s, and at most 20 re-asks.
+    ///
+    /// ```
+    /// let mut s = hil_speech::SpeechSettings::default();
+    /// assert!(s.validate().is_ok());
+    /// s.threshold = f64::NAN;
+    /// assert!(s.validate().is_err());
+    /// ```
+    pub fn validate(&self) -> Result<()> {
+        Self::check_patience(self.threshold, self.max_reasks, self.timeout_s)?;
+        if !(0.0..=1.0).contains(&self.max_clipped) {
+            return Err(HilError::invalid_input(
+                "max_clipped",
+                format!("must be between 0 and 1, got {}", self.max_clipped),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The one check of threshold, re-asks and timeout, shared by
+    /// [`validate`](Self::validate) and the `speech` channel's config.
+    pub(crate) fn check_patience(threshold: f64, max_reasks: usize, timeout_s: f64) -> Result<()> {
+        if !(0.0..=1.0).contains(&threshold) {
+            return Err(HilError::invalid_input(
+                "threshold",
+                format!("must be between 0 and 1, got {threshold}"),
+            ));
+        }
+        if !(timeout_s.is_finite() && timeout_s > 0.0 && timeout_s <= 600.0) {
+            return Err(HilError::invalid_input(
+                "timeout_s",
+                format!("must be over 0 and at most 600 seconds, got {timeout_s}"),
+            ));
+        }
+        if max_reasks > 20 {
+            return Err(HilError::invalid_input(
+                "max_reasks",
+                format!("at most 20, got {max_reasks}"),
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Default for SpeechSettings {
     fn default() -> Self {
         Self {

@@ -110,27 +110,7 @@ impl SpeechChannelConfig {
 #[typetag::serde(name = "speech")]
 impl QueryChannelConfig for SpeechChannelConfig {
     fn validate(&self) -> Result<()> {
-        if !(0.0..=1.0).contains(&self.threshold) {
-            return Err(HilError::invalid_input(
-                "threshold",
-                format!("must be between 0 and 1, got {}", self.threshold),
-            ));
-        }
-        if !(self.timeout_s.is_finite() && self.timeout_s > 0.0 && self.timeout_s <= 600.0) {
-            return Err(HilError::invalid_input(
-                "timeout_s",
-                format!(
-                    "must be over 0 and at most 600 seconds, got {}",
-                    self.timeout_s
-                ),
-            ));
-        }
-        if self.max_reasks > 20 {
-            return Err(HilError::invalid_input(
-                "max_reasks",
-                format!("at most 20, got {}", self.max_reasks),
-            ));
-        }
+        crate::SpeechSettings::check_patience(self.threshold, self.max_reasks, self.timeout_s)?;
         for (field, d) in [
             ("device", &self.device),
             ("output_device", &self.output_device),

@@ -23,6 +23,21 @@ fn counts_outside_their_limits_name_the_flag() {
     for flag in ["--dim", "--arms", "--steps", "--pretrain"] {
         refused(&["bench", "policy", "--policy", "linucb", flag, HUGE], flag);
     }
+    let out = std::env::temp_dir().join(format!("hil-count-limits-{}", std::process::id()));
+    let out = out.to_str().unwrap();
+    refused(&["data", "generate", "--out", out, "--dim", HUGE], "dim");
+    refused(
+        &[
+            "data",
+            "generate",
+            "--out",
+            out,
+            "--images-per-setting",
+            HUGE,
+        ],
+        "images_per_setting",
+    );
+    assert!(!std::path::Path::new(out).exists(), "nothing is written");
     let model = "bundled:f1_sim";
     refused(
         &[

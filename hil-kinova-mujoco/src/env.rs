@@ -137,35 +137,6 @@ impl KinovaFeedingConfig {
     fn parsed_settings(&self) -> Result<Vec<Setting>> {
         parse_labels("settings", &self.settings)
     }
-
-    fn validate(&self) -> Result<()> {
-        self.foods()?;
-        self.pretraining_foods()?;
-        self.parsed_settings()?;
-        if self.context_dim == 0 || self.context_dim > 4096 {
-            return Err(HilError::invalid_parameter(
-                "context_dim",
-                self.context_dim.to_string(),
-                "must be in 1..=4096",
-            ));
-        }
-        let n = &self.noise;
-        for (name, v) in [
-            ("noise.position_m", n.position_m),
-            ("noise.yaw_rad", n.yaw_rad),
-            ("noise.size_rel", n.size_rel),
-            ("noise.colour", n.colour),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(HilError::invalid_parameter(
-                    name,
-                    v.to_string(),
-                    "must be finite and ≥ 0",
-                ));
-            }
-        }
-        Ok(())
-    }
 }
 
 impl KinovaFeedingEnv {
@@ -204,13 +175,16 @@ impl KinovaFeedingConfig {
 }
 
 /// Largest `context_dim` a Kinova config may ask for.
-pub const MAX_CONTEXT_DIM: u64 = 65_536;
+pub const MAX_CONTEXT_DIM: u64 = 4096;
 /// Most `pretraining_trials` per (food, action) a Kinova config may ask for.
 pub const MAX_PRETRAINING_TRIALS: u64 = 10_000;
 
 #[typetag::serde(name = "kinova_feeding")]
 
 impl EnvironmentConfig for KinovaFeedingConfig {
+    /// Every check of the config, run when a config file is loaded (so an
+    /// error names the file, line and field) and again by
+    /// [`KinovaFeedingEnv::new`].
     fn validate(&self) -> Result<()> {
         use hil_config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
         check_count("plate", self.plate.len(), ITEMS_PER_EPISODE)?;
@@ -225,11 +199,31 @@ impl EnvironmentConfig for KinovaFeedingConfig {
             "pretraining_trials",
             self.pretraining_trials,
             MAX_PRETRAINING_TRIALS,
-        )
+        )?;
+        self.foods()?;
+        self.pretraining_foods()?;
+        self.parsed_settings()?;
+        let n = &self.noise;
+        for (name, v) in [
+            ("noise.position_m", n.position_m),
+            ("noise.yaw_rad", n.yaw_rad),
+            ("noise.size_rel", n.size_rel),
+            ("noise.colour", n.colour),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(HilError::invalid_parameter(
+                    name,
+                    v.to_string(),
+                    "must be finite and ≥ 0",
+                ));
+            }
+        }
+        crate::sim::check_hold(self.hold_s)
+            .map_err(|e| HilError::invalid_parameter("hold_s", self.hold_s, e.to_string()))
     }
 
     fn build(&self, ctx: &BuildContext) -> Result<Box<dyn Environment>> {
-        self.validate()?;
+        // `new` validates.
         Ok(Box::new(KinovaFeedingEnv::new(self.resolved(ctx))?))
     }
 
@@ -347,7 +341,7 @@ pub struct KinovaFeedingEnv {
 impl KinovaFeedingEnv {
     /// Builds the environment (loads the MJCF).
     pub fn new(cfg: KinovaFeedingConfig) -> Result<Self> {
-        cfg.validate()?;
+        EnvironmentConfig::validate(&cfg)?;
         let mut sim = match &cfg.mjcf {
             Some(p) => Simulator::from_source(MjcfSource::File(p))?,
             None => Simulator::new()?,

@@ -34,6 +34,16 @@ const MIN_INERTIA: f64 = 3e-6;
 const LEAF_RIB: f64 = 0.0035;
 /// Item height above the plate that counts as lifted (m).
 const LIFTED: f64 = 0.03;
+
+/// Checks a hold duration (s): finite and within 0–60 s. The one rule for
+/// [`Simulator::set_hold`] and a config's `hold_s`.
+pub(crate) fn check_hold(seconds: f64) -> Result<(), KinovaError> {
+    if seconds.is_finite() && (0.0..=60.0).contains(&seconds) {
+        Ok(())
+    } else {
+        Err(KinovaError::InvalidHold { seconds })
+    }
+}
 /// Step (s) of the phases in which no tine cuts: settling, the move to the
 /// pre-pose and the hold. Penetration and lift, where tines indent, pierce,
 /// cut and tear, run at the model's own step (at most [`REF_DT`]); a long
@@ -283,9 +293,7 @@ impl Simulator {
     /// Sets how long an item must stay on the lifted fork (s); the default
     /// is the published [`HOLD_SECONDS`].
     pub fn set_hold(&mut self, seconds: f64) -> Result<(), KinovaError> {
-        if !(seconds.is_finite() && (0.0..=60.0).contains(&seconds)) {
-            return Err(KinovaError::InvalidHold { seconds });
-        }
+        check_hold(seconds)?;
         self.hold = seconds;
         Ok(())
     }

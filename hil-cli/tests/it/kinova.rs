@@ -264,6 +264,23 @@ fn errors_in_a_study_file_name_file_line_and_field() {
     assert!(stderr.contains(&format!("{path}:5:")), "{stderr}");
     assert!(stderr.contains("methods.policy.alpha"), "{stderr}");
 
+    // A scene value out of range is found when the file is read, at its
+    // line, whichever check refuses it (limits, labels, noise, hold).
+    for (i, (key, value)) in [
+        ("hold_s", "-1.0"),
+        ("context_dim", "5000"),
+        ("plate", "[\"apple\"]"),
+        ("settings", "[\"wal\"]"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let text = format!("seed = 1\n[environment]\ntype = \"kinova_feeding\"\n{key} = {value}\n");
+        let (path, stderr) = demo_error(&format!("scene{i}.toml"), &text);
+        assert!(stderr.contains(&format!("{path}:4:")), "{stderr}");
+        assert!(stderr.contains(&format!("environment.{key}")), "{stderr}");
+    }
+
     let (path, stderr) = demo_error("table.toml", "[polcy]\n");
     assert!(stderr.contains(&format!("{path}:1:")), "{stderr}");
     assert!(stderr.contains("polcy"), "{stderr}");

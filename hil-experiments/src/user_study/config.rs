@@ -272,14 +272,25 @@ impl UserStudyConfig {
     fn validate_in(&self, text: &str, path: &Path) -> std::result::Result<(), ConfigError> {
         let at =
             |key: &[&str], msg: &str| hil_config::error_at_key(text, path, key, msg.to_string());
+        let located =
+            |section: &[&str], e: HilError| hil_config::error_in_section(text, path, section, e);
         self.session
             .validate()
-            .map_err(|e| hil_config::error_at_key(text, path, &["session"], e.to_string()))?;
+            .map_err(|e| located(&["session"], e))?;
         use hil_config::limits::{EPISODES, check_count};
-        check_count("repetitions", self.repetitions, EPISODES)
-            .map_err(|e| at(&["repetitions"], &e.to_string()))?;
+        check_count("repetitions", self.repetitions, EPISODES).map_err(|e| located(&[], e))?;
         check_count("plates", self.validation.plates, EPISODES)
-            .map_err(|e| at(&["validation", "plates"], &e.to_string()))?;
+            .map_err(|e| located(&["validation"], e))?;
+        // Every component's parameters, before anything is built, so that a
+        // bad value names its line (building checks them again).
+        let components: [(&str, Result<()>); 3] = [
+            ("environment", self.environment.validate()),
+            ("workload", self.workload.validate()),
+            ("channel", self.channel.validate()),
+        ];
+        for (section, checked) in components {
+            checked.map_err(|e| located(&[section], e))?;
+        }
         if !(0.0..=1.0).contains(&self.validation.w_task) {
             return Err(at(&["validation", "w_task"], "must be in [0, 1]"));
         }
@@ -307,6 +318,16 @@ impl UserStudyConfig {
                     &["methods", &index, "tune"],
                     "tune at most one hyperparameter, over at least one value",
                 ));
+            }
+            // The policy's values, at every point of its grid.
+            for point in m.grid() {
+                let section = match point {
+                    None => ["methods", index.as_str(), "policy"],
+                    Some(_) => ["methods", index.as_str(), "tune"],
+                };
+                m.config(&point)
+                    .and_then(|c| c.validate())
+                    .map_err(|e| located(&section, e))?;
             }
         }
         Ok(())

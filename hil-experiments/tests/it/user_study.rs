@@ -157,7 +157,31 @@ fn counts_are_validated() {
     assert_eq!(located(&err), (1, Some("methods")));
 
     let err = parse("[session]\nn_att = 0\n").unwrap_err();
-    assert_eq!(err.field.as_deref(), Some("session"));
+    assert_eq!(located(&err), (2, Some("session.n_att")));
+}
+
+/// A bad value of any component (environment, workload, channel, a
+/// method's policy or a value of its grid) is found when the file is read,
+/// at its line, not when the study builds it.
+#[test]
+fn component_values_are_located_when_the_file_is_read() {
+    let env = "[environment]\ntype = \"food_replay\"\nfoods = [\"banana\"]\n";
+    let err = parse(&format!("{env}items_per_episode = 0\n")).unwrap_err();
+    assert_eq!(located(&err), (4, Some("environment.items_per_episode")));
+
+    let policy = "[[methods]]\nlabel = \"L\"\n[methods.policy]\ntype = \"linucb\"\n";
+    let err = parse(&format!("{CHEAP_ENV}{policy}alpha = -1.0\n")).unwrap_err();
+    assert_eq!(err.field.as_deref(), Some("methods.policy.alpha"), "{err}");
+    assert_eq!(err.line, CHEAP_ENV.lines().count() + 5, "{err}");
+
+    let tuned = "[[methods]]\nlabel = \"L\"\ntune = { alpha = [0.5, -1.0] }\n\
+                 [methods.policy]\ntype = \"linucb\"\nalpha = 1.0\n";
+    let err = parse(&format!("{CHEAP_ENV}{tuned}")).unwrap_err();
+    assert_eq!(err.field.as_deref(), Some("methods.tune.alpha"), "{err}");
+
+    let channel = "[channel]\ntype = \"simulated_expert\"\nerror_rate = 2.0\n";
+    let err = parse(&format!("{CHEAP_ENV}{channel}")).unwrap_err();
+    assert_eq!(err.field.as_deref(), Some("channel.error_rate"), "{err}");
 }
 
 #[test]

@@ -38,29 +38,27 @@ fn counts_outside_their_limits_name_the_flag() {
         "images_per_setting",
     );
     assert!(!std::path::Path::new(out).exists(), "nothing is written");
-    let model = "bundled:f1_sim";
-    refused(
-        &[
-            "workload",
-            "rollout",
-            "--model",
-            model,
-            "--schedule",
-            "3",
-            "--steps",
-            HUGE,
-        ],
-        "steps",
-    );
-    refused(
-        &[
-            "workload",
-            "rollout",
-            "--model",
-            model,
-            "--schedule",
-            &format!("3,{HUGE}"),
-        ],
-        "schedule[1]",
-    );
+    let rollout = |extra: &[&str], names: &str| {
+        let mut args = vec!["workload", "rollout", "--model", "bundled:f1_sim"];
+        args.extend_from_slice(extra);
+        refused(&args, names);
+    };
+    rollout(&["--schedule", "3", "--steps", HUGE], "steps");
+    rollout(&["--schedule", &format!("3,{HUGE}")], "schedule[1]");
+}
+
+/// The simulation's commands: `hil kinova calibrate` and `hil demo kinova`.
+#[cfg(feature = "physics")]
+#[test]
+fn kinova_counts_outside_their_limits_name_the_flag() {
+    for (flag, value) in [("--seeds", "0"), ("--seeds", HUGE), ("--trials", HUGE)] {
+        refused(&["kinova", "calibrate", flag, value], flag);
+    }
+    for (flag, value) in [
+        ("--repetitions", HUGE),
+        ("--n-att", "1001"),
+        ("--seeds", HUGE),
+    ] {
+        refused(&["demo", "kinova", flag, value], flag);
+    }
 }

@@ -276,6 +276,7 @@ impl UserStudyConfig {
             |section: &[&str], e: HilError| hil_config::error_in_section(text, path, section, e);
         self.session
             .validate()
+            .and_then(|()| hil_config::check_session_limits(&self.session))
             .map_err(|e| located(&["session"], e))?;
         use hil_config::limits::{EPISODES, check_count};
         check_count("repetitions", self.repetitions, EPISODES).map_err(|e| located(&[], e))?;

@@ -158,6 +158,8 @@ fn counts_are_validated() {
 
     let err = parse("[session]\nn_att = 0\n").unwrap_err();
     assert_eq!(located(&err), (2, Some("session.n_att")));
+    let err = parse("[session]\nn_att = 1001\n").unwrap_err();
+    assert_eq!(located(&err), (2, Some("session.n_att")));
 }
 
 /// A bad value of any component (environment, workload, channel, a

@@ -29,6 +29,7 @@
 //! ```
 
 use std::collections::HashMap;
+use std::path::PathBuf;
 
 use std::time::{Duration, Instant};
 
@@ -44,6 +45,7 @@ use serde::Serialize;
 use crate::controller::{RollBy, actions};
 use crate::env::{KinovaFeedingConfig, KinovaFeedingEnv};
 use crate::food::{FoodKind, Setting};
+use crate::food_models::FoodModels;
 use crate::sim::AttemptReport;
 
 /// What to calibrate.
@@ -65,6 +67,9 @@ pub struct CalibrationOptions {
     /// model is compared; [`RollBy::ForkGamma`] runs the study robot's 2-DoF
     /// fork on the same foods.
     pub roll_by: RollBy,
+    /// A food-models file changing the built-in food mechanics
+    /// ([`FoodModels`]); `None` runs the built-in, calibrated ones.
+    pub food_models: Option<PathBuf>,
 }
 
 impl Default for CalibrationOptions {
@@ -76,6 +81,7 @@ impl Default for CalibrationOptions {
             seed: 1,
             threads: 1,
             roll_by: RollBy::ArmYaw,
+            food_models: None,
         }
     }
 }
@@ -174,6 +180,10 @@ pub struct CalibrationReport {
     pub hold_s: f64,
     /// What turned the tine row by the actions' roll.
     pub roll_by: RollBy,
+    /// The food-models file the run used instead of the built-in models,
+    /// if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub food_models: Option<FoodModelsUsed>,
     /// Physics steps per attempt (staging and execution), averaged.
     pub steps_per_attempt: f64,
     /// CPU time per physics step inside `mj_step` (µs), averaged (the CPU
@@ -192,6 +202,15 @@ pub struct CalibrationReport {
     pub overhead_share: f64,
     /// Provenance note.
     pub note: &'static str,
+}
+
+/// A food-models file a run used, and the kinds it changed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FoodModelsUsed {
+    /// The file.
+    pub path: PathBuf,
+    /// The kinds whose models it changed.
+    pub changed: Vec<FoodKind>,
 }
 
 /// Runs `trials` randomised attempts of every action on every food over all
@@ -235,6 +254,12 @@ pub fn calibrate_with(
         ));
     }
     hil_config::limits::check_count("trials", opts.trials, hil_config::limits::TRIALS)?;
+    // A bad food-models file fails here, before any attempt runs.
+    let models = FoodModels::from_file(opts.food_models.as_deref())?;
+    let food_models = opts.food_models.as_ref().map(|path| FoodModelsUsed {
+        path: path.clone(),
+        changed: models.changed().to_vec(),
+    });
     let start = Instant::now();
     let jobs: Vec<(FoodKind, usize, usize)> = opts
         .foods
@@ -258,6 +283,7 @@ pub fn calibrate_with(
                         plate: vec![food.name().to_string()],
                         settings: vec![setting.name().to_string()],
                         roll_by: opts.roll_by,
+                        food_models: opts.food_models.clone(),
                         ..KinovaFeedingConfig::default()
                     })?)
                 }
@@ -337,6 +363,7 @@ pub fn calibrate_with(
         max_abs_error,
         hold_s,
         roll_by: opts.roll_by,
+        food_models,
         steps_per_attempt: steps as f64 / total.max(1) as f64,
         micros_per_step: 1e6
             * cpu.as_secs_f64()

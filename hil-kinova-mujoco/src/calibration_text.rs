@@ -35,7 +35,7 @@ fn write_run(o: &mut String, opts: &CalibrationOptions, report: &CalibrationRepo
         "Simulated success rate (published rate) per action; {} trials each ({} per setting).",
         opts.trials, per_setting
     )?;
-    write_tool(o, report.roll_by)?;
+    write_tool(o, report)?;
     write_table(o, &report.rows)?;
     writeln!(
         o,
@@ -67,7 +67,9 @@ fn write_run(o: &mut String, opts: &CalibrationOptions, report: &CalibrationRepo
     Ok(())
 }
 
-fn write_tool(o: &mut String, roll_by: RollBy) -> fmt::Result {
+/// The tool, and the food models when a file changed them.
+fn write_tool(o: &mut String, report: &CalibrationReport) -> fmt::Result {
+    let roll_by = report.roll_by;
     writeln!(
         o,
         "Simulated attempts with synthetic food properties, tool `{}`{}; published: Feng et al. 2019.",
@@ -78,6 +80,19 @@ fn write_tool(o: &mut String, roll_by: RollBy) -> fmt::Result {
                 " (the study's 2-DoF fork: not the tool the published rates measured)",
         }
     )?;
+    if let Some(m) = &report.food_models {
+        let changed: Vec<&str> = m.changed.iter().map(|k| k.name()).collect();
+        writeln!(
+            o,
+            "Food models from {} (changed: {}), not the built-in calibration.",
+            m.path.display(),
+            if changed.is_empty() {
+                "none".to_string()
+            } else {
+                changed.join(", ")
+            }
+        )?;
+    }
     Ok(())
 }
 
@@ -194,7 +209,7 @@ fn write_over_seeds(o: &mut String, over: &CalibrationOverSeeds) -> fmt::Result 
         seeds[0],
         seeds[seeds.len() - 1]
     )?;
-    write_tool(o, first.roll_by)?;
+    write_tool(o, first)?;
     write_table(o, &over.pooled)?;
     for (run, seed) in over.runs.iter().zip(seeds) {
         writeln!(

@@ -28,7 +28,8 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::controller::{RollBy, actions};
-use crate::food::{FoodKind, FoodModel, FoodProps, Setting, parse_labels};
+use crate::food::{FoodKind, FoodProps, Setting, parse_labels};
+use crate::food_models::FoodModels;
 use crate::model::MjcfSource;
 use crate::perception::{Embedding, Observation, PerceptionNoise, RIM_RADIUS, perceive};
 use crate::sim::{AttemptReport, KeyframeHook, LeafPlacement, Placement, Simulator};
@@ -56,6 +57,10 @@ pub struct KinovaFeedingConfig {
     /// A custom scene (MJCF) instead of the built-in one.
     #[serde(default)]
     pub mjcf: Option<PathBuf>,
+    /// A food-models file changing the built-in food mechanics (see
+    /// [`FoodModels`](crate::FoodModels)), resolved like `mjcf`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub food_models: Option<PathBuf>,
     /// Perception noise.
     #[serde(default)]
     pub noise: PerceptionNoise,
@@ -111,6 +116,7 @@ impl Default for KinovaFeedingConfig {
             settings: default_settings(),
             neighbours: true,
             mjcf: None,
+            food_models: None,
             noise: PerceptionNoise::default(),
             pretraining_trials: 0,
             pretrain_foods: Vec::new(),
@@ -170,6 +176,7 @@ impl KinovaFeedingConfig {
     pub fn resolved(&self, ctx: &BuildContext) -> Self {
         let mut cfg = self.clone();
         cfg.mjcf = cfg.mjcf.map(|p| ctx.resolve(&p));
+        cfg.food_models = cfg.food_models.map(|p| ctx.resolve(&p));
         cfg
     }
 }
@@ -327,7 +334,7 @@ pub struct KinovaFeedingEnv {
     cfg: KinovaFeedingConfig,
     foods: Vec<FoodKind>,
     settings: Vec<Setting>,
-    models: Vec<FoodModel>,
+    models: FoodModels,
     sim: Simulator,
     embedding: Embedding,
     actions: ActionSpace,
@@ -353,10 +360,7 @@ impl KinovaFeedingEnv {
         Ok(Self {
             foods: cfg.foods()?,
             settings: cfg.parsed_settings()?,
-            models: FoodKind::ALL
-                .iter()
-                .map(|&k| FoodModel::default_for(k))
-                .collect(),
+            models: FoodModels::from_file(cfg.food_models.as_deref())?,
             embedding: Embedding::new(cfg.context_dim, cfg.embedding_seed),
             sim,
             actions: hil_envs::feeding::action_space(),
@@ -475,7 +479,7 @@ impl KinovaFeedingEnv {
                 if placed.iter().any(|p| p.props.kind.slot() == k.slot()) {
                     continue;
                 }
-                let props = self.models[k.index()].sample(rng);
+                let props = self.models.get(k).sample(rng);
                 let r = props.shape.half_extents()[0];
                 for _ in 0..200 {
                     let rad = (RIM_RADIUS - r - 0.003).max(0.0) * rng.random::<f64>().sqrt();
@@ -533,7 +537,7 @@ impl Environment for KinovaFeedingEnv {
             self.calls.on_next_item(false);
             return Ok(None);
         };
-        let props = self.models[kind.index()].sample(&mut self.rng);
+        let props = self.models.get(kind).sample(&mut self.rng);
         let setting = self.settings[self.rng.random_range(0..self.settings.len())];
         let item = Item::new(self.cursor, kind.name().to_string()).with_description(format!(
             "{} {}",

@@ -46,6 +46,8 @@ mod error;
 #[cfg(feature = "physics")]
 mod food;
 #[cfg(feature = "physics")]
+mod food_models;
+#[cfg(feature = "physics")]
 mod model;
 #[cfg(feature = "physics")]
 mod perception;
@@ -63,8 +65,8 @@ pub use attempt_log::AttemptLog;
 #[cfg(feature = "physics")]
 pub use calibrate::{
     AttemptRecord, CalibrationOptions, CalibrationOverSeeds, CalibrationReport, CalibrationRow,
-    CalibrationTarget, CellP, Consistency, SettingCell, TARGET_GRID, Tally, calibrate,
-    calibrate_over_seeds, calibrate_with, expected_abs_error_of_a_perfect_simulator,
+    CalibrationTarget, CellP, Consistency, FoodModelsUsed, SettingCell, TARGET_GRID, Tally,
+    calibrate, calibrate_over_seeds, calibrate_with, expected_abs_error_of_a_perfect_simulator,
 };
 #[cfg(feature = "physics")]
 pub use controller::{Action, PitchFamily, RollBy, actions};
@@ -77,6 +79,8 @@ pub use env::{
 pub use error::KinovaError;
 #[cfg(feature = "physics")]
 pub use food::{FoodKind, FoodModel, FoodProps, Label, Setting, Shape, parse_labels};
+#[cfg(feature = "physics")]
+pub use food_models::FoodModels;
 #[cfg(feature = "physics")]
 pub use model::MjcfSource;
 #[cfg(feature = "physics")]

@@ -76,6 +76,13 @@ pub struct CalibrateArgs {
     /// handle and whose servos yield: the same foods on another tool).
     #[arg(long, default_value = "arm_yaw")]
     pub roll_by: String,
+    /// A food-models file (TOML: a table per food, e.g. `[banana]`, whose
+    /// keys replace that food's built-in mechanics, such as
+    /// `puncture_force = [0.6, 0.3]`): try other mechanics or fit your own
+    /// without rebuilding. The report names the file and the foods it
+    /// changed. Errors name file, line and field.
+    #[arg(long, value_name = "FILE")]
+    pub food_models: Option<PathBuf>,
     /// Print a JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -195,6 +202,7 @@ fn calibrate(args: CalibrateArgs) -> Result<()> {
         trials: args.trials,
         seed: args.seed,
         threads: args.threads.threads,
+        food_models: args.food_models.clone(),
     };
     let quiet = args.quiet;
     let runs = args.seeds;

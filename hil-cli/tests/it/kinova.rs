@@ -124,6 +124,45 @@ fn calibrate_prints_rates_beside_the_published_ones() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("bowl"));
 }
 
+/// A food-models file changes the mechanics of the foods it names: the
+/// report says so, and the changed carrot behaves differently from the
+/// built-in one on the same seeds; a bad file is a located error.
+#[test]
+#[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
+fn calibrate_runs_a_food_models_file() {
+    let dir = crate::demo::scratch_dir("kinova-food-models", "calibrate");
+    // A carrot no tine can pierce within any action's force threshold.
+    let hard = dir.join("hard.toml");
+    std::fs::write(&hard, "[carrot]\npuncture_force = [900.0, 0.0]\n").unwrap();
+    let v = calibrate_carrot_json(&["--food-models", hard.to_str().unwrap()]);
+    assert_eq!(v["food_models"]["changed"], serde_json::json!(["carrot"]));
+    let built_in = calibrate_carrot_json(&[]);
+    assert!(built_in.get("food_models").is_none());
+    let successes = |v: &serde_json::Value| -> u64 {
+        let rows = v["rows"].as_array().unwrap();
+        rows.iter().map(|r| r["successes"].as_u64().unwrap()).sum()
+    };
+    assert_eq!(successes(&v), 0, "nothing pierces a 900 N carrot");
+    assert!(successes(&built_in) > 0, "the built-in carrot is skewered");
+
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "[carrot]\n\ngrip_per_m = [-1.0, 0.3]\n").unwrap();
+    let out = hil(&[
+        "kinova",
+        "calibrate",
+        "--food-models",
+        bad.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains(&format!("{}:3:", bad.display())),
+        "{stderr}"
+    );
+    assert!(stderr.contains("carrot.grip_per_m"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 #[ignore = "e2e: needs MuJoCo physics; bash scripts/test runs it"]
 fn the_demo_runs_a_study_file_and_renders_or_says_why_not() {
@@ -263,6 +302,21 @@ fn errors_in_a_study_file_name_file_line_and_field() {
         assert!(stderr.contains(&format!("{path}:4:")), "{stderr}");
         assert!(stderr.contains(&format!("environment.{key}")), "{stderr}");
     }
+
+    // A food-models file is read from beside the study file; its errors
+    // name its own file, line and field.
+    let dir = std::env::temp_dir().join(format!("hil-kinova-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let foods = dir.join("foods.toml");
+    std::fs::write(&foods, "[banana]\ndig_in_angle = 3.0\n").unwrap();
+    let text = "[environment]\ntype = \"kinova_feeding\"\nfood_models = \"foods.toml\"\n";
+    let (_, stderr) = demo_error("with-foods.toml", text);
+    assert!(
+        stderr.contains(&format!("{}:2:", foods.display())),
+        "{stderr}"
+    );
+    assert!(stderr.contains("banana.dig_in_angle"), "{stderr}");
+    std::fs::remove_file(&foods).ok();
 
     let (path, stderr) = demo_error("table.toml", "[polcy]\n");
     assert!(stderr.contains(&format!("{path}:1:")), "{stderr}");

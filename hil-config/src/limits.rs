@@ -131,6 +131,47 @@ where
     }
 }
 
+/// Checks that the real `value` of the field `name` is finite and in
+/// `[min, max]`.
+///
+/// ```
+/// use hil_config::limits::check_real_in;
+/// assert!(check_real_in("sd", 0.5, 0.0, 1.0).is_ok());
+/// assert!(check_real_in("sd", f64::NAN, 0.0, 1.0).is_err());
+/// assert!(check_real_in("sd", 1.5, 0.0, 1.0).is_err());
+/// ```
+pub fn check_real_in(name: &str, value: f64, min: f64, max: f64) -> Result<()> {
+    if value.is_finite() && (min..=max).contains(&value) {
+        Ok(())
+    } else {
+        Err(HilError::invalid_parameter(
+            name,
+            value,
+            format!("must be a number in [{min}, {max}]"),
+        ))
+    }
+}
+
+/// Checks that the real `value` of the field `name` is finite, over 0 and
+/// at most `max` (a size, a force, a density).
+///
+/// ```
+/// use hil_config::limits::check_real_positive;
+/// assert!(check_real_positive("density", 950.0, 5000.0).is_ok());
+/// assert!(check_real_positive("density", 0.0, 5000.0).is_err());
+/// ```
+pub fn check_real_positive(name: &str, value: f64, max: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 && value <= max {
+        Ok(())
+    } else {
+        Err(HilError::invalid_parameter(
+            name,
+            value,
+            format!("must be over 0 and at most {max}"),
+        ))
+    }
+}
+
 /// Checks that the duration `value` (seconds) of the field `name` is finite,
 /// positive and at most [`SECONDS`].
 pub fn check_seconds(name: &str, value: f64) -> Result<()> {

@@ -28,6 +28,8 @@ use std::path::Path;
 use hil_core::{ConfigError, HilError, Result};
 use serde::Deserialize;
 
+use hil_config::limits::{check_real_in, check_real_positive};
+
 use crate::food::{FoodKind, FoodModel, parse_label};
 
 /// The model of every food kind (in [`FoodKind::ALL`] order).
@@ -186,8 +188,8 @@ impl FoodModel {
                 );
             }
         }
-        in_range("dims_rel_sd", self.dims_rel_sd, 0.0, 0.5)?;
-        positive("density", self.density, 5000.0)?;
+        check_real_in("dims_rel_sd", self.dims_rel_sd, 0.0, 0.5)?;
+        check_real_positive("density", self.density, 5000.0)?;
         let pairs = [
             ("puncture_force", self.puncture_force, 1000.0),
             ("grip_per_m", self.grip_per_m, 1e6),
@@ -196,7 +198,7 @@ impl FoodModel {
             ("plate_friction", self.plate_friction, 3.0),
         ];
         for (name, (mean, rel_sd), max) in pairs {
-            positive(name, mean, max)?;
+            check_real_positive(name, mean, max)?;
             if !(rel_sd.is_finite() && (0.0..=1.0).contains(&rel_sd)) {
                 return bad(
                     name,
@@ -205,40 +207,14 @@ impl FoodModel {
                 );
             }
         }
-        positive("puncture_indent", self.puncture_indent, 0.02)?;
-        in_range("cut_fraction", self.cut_fraction, 0.0, 10.0)?;
-        positive("cut_fraction_of_width", self.cut_fraction_of_width, 10.0)?;
-        positive(
+        check_real_positive("puncture_indent", self.puncture_indent, 0.02)?;
+        check_real_in("cut_fraction", self.cut_fraction, 0.0, 10.0)?;
+        check_real_positive("cut_fraction_of_width", self.cut_fraction_of_width, 10.0)?;
+        check_real_positive(
             "dig_in_angle",
             self.dig_in_angle,
             std::f64::consts::FRAC_PI_2,
         )
-    }
-}
-
-/// `value` is finite, over 0 and at most `max`.
-fn positive(name: &str, value: f64, max: f64) -> Result<()> {
-    if value.is_finite() && value > 0.0 && value <= max {
-        Ok(())
-    } else {
-        Err(HilError::invalid_parameter(
-            name,
-            value,
-            format!("must be over 0 and at most {max}"),
-        ))
-    }
-}
-
-/// `value` is finite and in `[min, max]`.
-fn in_range(name: &str, value: f64, min: f64, max: f64) -> Result<()> {
-    if value.is_finite() && (min..=max).contains(&value) {
-        Ok(())
-    } else {
-        Err(HilError::invalid_parameter(
-            name,
-            value,
-            format!("must be in [{min}, {max}]"),
-        ))
     }
 }
 

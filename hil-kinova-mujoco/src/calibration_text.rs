@@ -82,16 +82,20 @@ fn write_tool(o: &mut String, report: &CalibrationReport) -> fmt::Result {
     )?;
     if let Some(m) = &report.food_models {
         let changed: Vec<&str> = m.changed.iter().map(|k| k.name()).collect();
-        writeln!(
-            o,
-            "Food models from {} (changed: {}), not the built-in calibration.",
-            m.path.display(),
-            if changed.is_empty() {
-                "none".to_string()
-            } else {
+        if changed.is_empty() {
+            writeln!(
+                o,
+                "Food models from {}: the built-in values.",
+                m.path.display()
+            )?;
+        } else {
+            writeln!(
+                o,
+                "Food models from {} (changed: {}), not the built-in calibration.",
+                m.path.display(),
                 changed.join(", ")
-            }
-        )?;
+            )?;
+        }
     }
     Ok(())
 }

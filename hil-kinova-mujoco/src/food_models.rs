@@ -106,8 +106,11 @@ impl FoodModels {
             model
                 .validate()
                 .map_err(|e| hil_config::error_in_section(text, path, &[name], e))?;
+            // A table that repeats the built-in values changes nothing.
+            if model != FoodModel::default_for(kind) {
+                models.changed.push(kind);
+            }
             models.by_kind[kind.index()] = model;
-            models.changed.push(kind);
         }
         Ok(models)
     }
@@ -117,9 +120,43 @@ impl FoodModels {
         &self.by_kind[kind.index()]
     }
 
-    /// The kinds whose model a file changed (empty for the built-in models).
+    /// The kinds whose model a file changed from the built-in one (in the
+    /// file's order; empty for the built-in models).
     pub fn changed(&self) -> &[FoodKind] {
         &self.changed
+    }
+
+    /// Every kind's model as a food-models file, which [`parse`](Self::parse)
+    /// reads back to the same models: the knobs and their values, to copy
+    /// and edit (`hil kinova food-models`).
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use hil_kinova_mujoco::FoodModels;
+    /// let text = FoodModels::builtin().to_toml()?;
+    /// assert!(text.contains("[carrot]"));
+    /// let back = FoodModels::parse(&text, Path::new("printed.toml")).unwrap();
+    /// assert_eq!(back.get(hil_kinova_mujoco::FoodKind::Carrot),
+    ///            FoodModels::builtin().get(hil_kinova_mujoco::FoodKind::Carrot));
+    /// # Ok::<(), hil_core::HilError>(())
+    /// ```
+    pub fn to_toml(&self) -> Result<String> {
+        let mut file = toml::Table::new();
+        for kind in FoodKind::ALL {
+            let value = toml::Value::try_from(self.get(kind))
+                .map_err(|e| HilError::serde("food model", e))?;
+            let Some(mut table) = value.as_table().cloned() else {
+                return Err(HilError::invalid_input("food model", "not a table"));
+            };
+            // The table's name says the kind.
+            table.remove("kind");
+            file.insert(kind.name().to_string(), toml::Value::Table(table));
+        }
+        let body = toml::to_string(&file).map_err(|e| HilError::serde("food models", e))?;
+        Ok(format!(
+            "# Food models of hil-kinova-mujoco (synthetic, calibrated to published success\n\
+             # rates; see FoodModel for each field). Pairs are [mean, relative sd].\n\n{body}"
+        ))
     }
 }
 
@@ -236,6 +273,9 @@ mod tests {
             FoodModel::default_for(kind).validate().unwrap();
         }
         assert_eq!(parse("").unwrap(), FoodModels::builtin());
+        // The printed models read back unchanged.
+        let printed = FoodModels::builtin().to_toml().unwrap();
+        assert_eq!(parse(&printed).unwrap(), FoodModels::builtin());
     }
 
     #[test]

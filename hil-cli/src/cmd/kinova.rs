@@ -40,6 +40,18 @@ pub enum KinovaCommand {
     /// Success rate per (food, action) over randomised simulated trials,
     /// beside the published rates.
     Calibrate(CalibrateArgs),
+    /// Print the food models a run uses (the built-in, calibrated ones, or
+    /// those with a food-models file's changes) as a food-models file: the
+    /// knobs of every food kind and their values, to copy and edit.
+    FoodModels(FoodModelsArgs),
+}
+
+/// Arguments of `hil kinova food-models`.
+#[derive(Debug, clap::Args)]
+pub struct FoodModelsArgs {
+    /// A food-models file whose changes to apply before printing.
+    #[arg(long, value_name = "FILE")]
+    pub food_models: Option<PathBuf>,
 }
 
 /// Arguments of `hil kinova calibrate`.
@@ -162,6 +174,10 @@ pub struct KinovaDemoArgs {
 pub fn kinova(args: KinovaArgs) -> Result<()> {
     match args.command {
         KinovaCommand::Calibrate(a) => calibrate(a),
+        KinovaCommand::FoodModels(a) => {
+            let models = hil_kinova_mujoco::FoodModels::from_file(a.food_models.as_deref())?;
+            outln!("{}", models.to_toml()?)
+        }
     }
 }
 

@@ -124,6 +124,41 @@ fn calibrate_prints_rates_beside_the_published_ones() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("bowl"));
 }
 
+/// `hil kinova food-models` prints every food's knobs as a food-models
+/// file, with a given file's changes applied; the printout reads back.
+#[test]
+fn food_models_prints_the_knobs_a_run_uses() {
+    let dir = crate::demo::scratch_dir("kinova-food-models", "print");
+    let out = hil(&["kinova", "food-models"]);
+    assert!(out.status.success());
+    let built_in = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(built_in.contains("[banana]") && built_in.contains("puncture_force"));
+    let file = dir.join("printed.toml");
+    std::fs::write(
+        &file,
+        built_in.replace("density = 950.0", "density = 1000.0"),
+    )
+    .unwrap();
+    let out = hil(&[
+        "kinova",
+        "food-models",
+        "--food-models",
+        file.to_str().unwrap(),
+    ]);
+    let changed = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(changed.contains("density = 1000.0"), "{changed}");
+    assert_eq!(
+        changed.replace("density = 1000.0", "density = 950.0"),
+        built_in
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A food-models file changes the mechanics of the foods it names: the
 /// report says so, and the changed carrot behaves differently from the
 /// built-in one on the same seeds; a bad file is a located error.

@@ -141,15 +141,9 @@ where
 /// assert!(check_real_in("sd", 1.5, 0.0, 1.0).is_err());
 /// ```
 pub fn check_real_in(name: &str, value: f64, min: f64, max: f64) -> Result<()> {
-    if value.is_finite() && (min..=max).contains(&value) {
-        Ok(())
-    } else {
-        Err(HilError::invalid_parameter(
-            name,
-            value,
-            format!("must be a number in [{min}, {max}]"),
-        ))
-    }
+    check_real(name, value, (min..=max).contains(&value), || {
+        format!("must be a number in [{min}, {max}]")
+    })
 }
 
 /// Checks that the real `value` of the field `name` is finite, over 0 and
@@ -161,28 +155,26 @@ pub fn check_real_in(name: &str, value: f64, min: f64, max: f64) -> Result<()> {
 /// assert!(check_real_positive("density", 0.0, 5000.0).is_err());
 /// ```
 pub fn check_real_positive(name: &str, value: f64, max: f64) -> Result<()> {
-    if value.is_finite() && value > 0.0 && value <= max {
-        Ok(())
-    } else {
-        Err(HilError::invalid_parameter(
-            name,
-            value,
-            format!("must be over 0 and at most {max}"),
-        ))
-    }
+    check_real(name, value, value > 0.0 && value <= max, || {
+        format!("must be over 0 and at most {max}")
+    })
 }
 
 /// Checks that the duration `value` (seconds) of the field `name` is finite,
 /// positive and at most [`SECONDS`].
 pub fn check_seconds(name: &str, value: f64) -> Result<()> {
-    if value.is_finite() && value > 0.0 && value <= SECONDS {
+    check_real(name, value, value > 0.0 && value <= SECONDS, || {
+        format!("must be a number of seconds in (0, {SECONDS}]")
+    })
+}
+
+/// The one shape of the real-valued checks: `value` must be finite and
+/// `in_range`, else the error says `why`.
+fn check_real(name: &str, value: f64, in_range: bool, why: impl FnOnce() -> String) -> Result<()> {
+    if value.is_finite() && in_range {
         Ok(())
     } else {
-        Err(HilError::invalid_parameter(
-            name,
-            value,
-            format!("must be a number of seconds in (0, {SECONDS}]"),
-        ))
+        Err(HilError::invalid_parameter(name, value, why()))
     }
 }
 

@@ -258,7 +258,7 @@ pub fn calibrate_with(
     let models = FoodModels::from_file(opts.food_models.as_deref())?;
     let food_models = opts.food_models.as_ref().map(|path| FoodModelsUsed {
         path: path.clone(),
-        changed: models.changed().to_vec(),
+        changed: models.changed(),
     });
     let start = Instant::now();
     let jobs: Vec<(FoodKind, usize, usize)> = opts
@@ -279,13 +279,16 @@ pub fn calibrate_with(
             let env = match envs.entry((food, setting)) {
                 std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
                 std::collections::hash_map::Entry::Vacant(e) => {
-                    e.insert(KinovaFeedingEnv::new(KinovaFeedingConfig {
+                    // The models read once above; the config still names
+                    // the file, as the scene it describes uses it.
+                    let scene = KinovaFeedingConfig {
                         plate: vec![food.name().to_string()],
                         settings: vec![setting.name().to_string()],
                         roll_by: opts.roll_by,
                         food_models: opts.food_models.clone(),
                         ..KinovaFeedingConfig::default()
-                    })?)
+                    };
+                    e.insert(KinovaFeedingEnv::with_models(scene, models.clone())?)
                 }
             };
             let seed = trial_seed(opts.seed, food, a, t);

@@ -284,14 +284,16 @@ pub fn simulated_pretraining(
     let mut foods = cfg.pretraining_foods()?;
     foods.sort();
     foods.dedup();
+    let models = FoodModels::from_file(cfg.food_models.as_deref())?;
     let mut out = Vec::new();
     for food in foods {
-        let mut env = KinovaFeedingEnv::new(KinovaFeedingConfig {
+        let scene = KinovaFeedingConfig {
             plate: vec![food.name().to_string()],
             neighbours: false,
             pretraining_trials: 0,
             ..cfg.clone()
-        })?;
+        };
+        let mut env = KinovaFeedingEnv::with_models(scene, models.clone())?;
         for arm in 0..actions().len() {
             for t in 0..cfg.pretraining_trials {
                 let stream = (food.index() * actions().len() + arm) * cfg.pretraining_trials + t;
@@ -346,8 +348,16 @@ pub struct KinovaFeedingEnv {
 }
 
 impl KinovaFeedingEnv {
-    /// Builds the environment (loads the MJCF).
+    /// Builds the environment (loads the MJCF and the food-models file).
     pub fn new(cfg: KinovaFeedingConfig) -> Result<Self> {
+        let models = FoodModels::from_file(cfg.food_models.as_deref())?;
+        Self::with_models(cfg, models)
+    }
+
+    /// Builds the environment with food models already read from
+    /// `cfg.food_models`, so that a caller building many scenes from one
+    /// config reads the file once.
+    pub(crate) fn with_models(cfg: KinovaFeedingConfig, models: FoodModels) -> Result<Self> {
         EnvironmentConfig::validate(&cfg)?;
         let mut sim = match &cfg.mjcf {
             Some(p) => Simulator::from_source(MjcfSource::File(p))?,
@@ -360,7 +370,7 @@ impl KinovaFeedingEnv {
         Ok(Self {
             foods: cfg.foods()?,
             settings: cfg.parsed_settings()?,
-            models: FoodModels::from_file(cfg.food_models.as_deref())?,
+            models,
             embedding: Embedding::new(cfg.context_dim, cfg.embedding_seed),
             sim,
             actions: hil_envs::feeding::action_space(),

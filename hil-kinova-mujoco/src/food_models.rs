@@ -36,7 +36,6 @@ use crate::food::{FoodKind, FoodModel, parse_label};
 #[derive(Clone, Debug, PartialEq)]
 pub struct FoodModels {
     by_kind: Vec<FoodModel>,
-    changed: Vec<FoodKind>,
 }
 
 impl Default for FoodModels {
@@ -53,7 +52,6 @@ impl FoodModels {
                 .iter()
                 .map(|&k| FoodModel::default_for(k))
                 .collect(),
-            changed: Vec::new(),
         }
     }
 
@@ -100,16 +98,10 @@ impl FoodModels {
             let Some(fields) = value.as_table() else {
                 return Err(at(&[name], "must be a table of model fields".into()));
             };
-            let model = patched(&FoodModel::default_for(kind), fields, &|key, why| {
-                at(&[name, key], why)
-            })?;
+            let model = patched(models.get(kind), fields, &|key, why| at(&[name, key], why))?;
             model
                 .validate()
                 .map_err(|e| hil_config::error_in_section(text, path, &[name], e))?;
-            // A table that repeats the built-in values changes nothing.
-            if model != FoodModel::default_for(kind) {
-                models.changed.push(kind);
-            }
             models.by_kind[kind.index()] = model;
         }
         Ok(models)
@@ -120,10 +112,16 @@ impl FoodModels {
         &self.by_kind[kind.index()]
     }
 
-    /// The kinds whose model a file changed from the built-in one (in the
-    /// file's order; empty for the built-in models).
-    pub fn changed(&self) -> &[FoodKind] {
-        &self.changed
+    /// The kinds whose model differs from the built-in one, by name (a
+    /// table that repeats the built-in values changes nothing; empty for
+    /// the built-in models).
+    pub fn changed(&self) -> Vec<FoodKind> {
+        let mut changed: Vec<FoodKind> = FoodKind::ALL
+            .into_iter()
+            .filter(|&k| *self.get(k) != FoodModel::default_for(k))
+            .collect();
+        changed.sort_by_key(|k| k.name());
+        changed
     }
 
     /// Every kind's model as a food-models file, which [`parse`](Self::parse)
@@ -171,6 +169,9 @@ fn patched(
     let Some(mut merged) = serialised.as_table().cloned() else {
         return Err(at("", "the built-in model is not a table".into()));
     };
+    // Each field is checked as it is put in, so that an error names it;
+    // the last check's model is the result.
+    let mut model = base.clone();
     for (key, value) in fields {
         if key == "kind" {
             return Err(at(key, "is the table's name; leave it out".into()));
@@ -185,10 +186,10 @@ fn patched(
             return Err(at(key, why));
         }
         merged.insert(key.clone(), value.clone());
-        FoodModel::deserialize(toml::Value::Table(merged.clone()))
+        model = FoodModel::deserialize(toml::Value::Table(merged.clone()))
             .map_err(|e| at(key, e.message().trim().to_string()))?;
     }
-    FoodModel::deserialize(toml::Value::Table(merged)).map_err(|e| at("", e.message().to_string()))
+    Ok(model)
 }
 
 impl FoodModel {

@@ -20,6 +20,8 @@
 //! | [`SEEDS`] | 10 000 | seeds one run sweeps: a protocol's environment and policy seeds, `--seeds` of `hil kinova calibrate` and `hil demo kinova` |
 //! | [`TIMESTEPS`] | 1 000 000 | the last timestep of a workload rollout and of its query schedule |
 //! | [`TRIALS`] | 1 000 000 | trials per food and action of a simulated calibration (`--trials`) |
+//! | [`CONTEXT_DIM`] | 8 192 | the context dimension of a linear policy's estimator, a Kinova scene, a conformance check and `hil bench policy --dim` |
+//! | [`ARMS`] | 1 024 | the arms of a linear policy's estimator and of `hil bench policy --arms` |
 //!
 //! Component crates call [`check_count`] (a count that must be at least 1)
 //! or [`check_at_most`] (one that may be 0) from their config's
@@ -72,6 +74,16 @@ pub const TIMESTEPS: u64 = 1_000_000;
 /// limit, the three calibrated foods take 18 million attempts (days on a
 /// workstation), and the job list still fits in memory.
 pub const TRIALS: u64 = 1_000_000;
+
+/// Largest context dimension (the paper's image features have 2048). A
+/// linear estimator's arm in its dense form holds a packed d × d factor, so
+/// at this limit an arm takes 256 MiB; a 20-digit dimension is an error
+/// naming the field, not an allocation that aborts the process.
+pub const CONTEXT_DIM: u64 = 8192;
+
+/// Most arms (actions a linear estimator keeps a model for; the paper's
+/// task has six).
+pub const ARMS: u64 = 1024;
 
 /// The `n` consecutive master seeds `first`, `first + 1`, ... of a run over
 /// seeds (wrapping past `u64::MAX` to 0), after checking that `n`, the

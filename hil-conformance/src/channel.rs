@@ -5,7 +5,7 @@ use super::{Check, CheckOptions, Checker, ConformanceFailure, ConformanceReport,
 use hil_core::{ArmId, Item, Query, QueryChannel, QueryKind, Response};
 
 /// Runs the query-channel checks that one instance allows: asks `n`
-/// queries covering every response type, difficulty and distraction (over
+/// (1 to [`crate::MAX_CHECK_STEPS`]) queries covering every response type, difficulty and distraction (over
 /// the default options' six task-neutral actions, with an oracle answer
 /// set, as a simulated environment would). Seeded replay, the long run and
 /// the destructor check need instances of the suite's own: prefer
@@ -17,7 +17,10 @@ pub fn check_query_channel(
     channel: &mut dyn QueryChannel,
     n: usize,
 ) -> Result<ConformanceReport, ConformanceFailure> {
-    let opts = CheckOptions::default().with_queries(n.max(1));
+    let opts = CheckOptions::default().with_queries(n);
+    // n = 0 (or past the limit) is a Build failure naming `queries`.
+    opts.validate()
+        .map_err(|e| ConformanceFailure::of_factory("query channel", &e))?;
     let mut c = Checker::new(channel.name(), None);
     answers(&mut c, channel, &opts, opts.queries())?;
     c.skip(

@@ -10,7 +10,9 @@ const MAX_ITEMS: usize = 10_000;
 type Make<'a> = &'a dyn Fn() -> hil_core::Result<Box<dyn Environment>>;
 
 /// Runs the environment conformance suite on environments built by `make`,
-/// with at most `attempts_per_item` attempts at each item; see
+/// with at most `attempts_per_item` attempts at each item (1 to
+/// [`hil_config::limits::ATTEMPTS_PER_ITEM`]: outside that, a
+/// [`Check::Build`](crate::Check::Build) failure naming `attempts`); see
 /// [`check_environment_with`] for the checks.
 pub fn check_environment(
     make: Make<'_>,
@@ -18,7 +20,7 @@ pub fn check_environment(
 ) -> Result<ConformanceReport, ConformanceFailure> {
     check_environment_with(
         make,
-        &CheckOptions::default().with_attempts(attempts_per_item.max(1)),
+        &CheckOptions::default().with_attempts(attempts_per_item),
     )
 }
 

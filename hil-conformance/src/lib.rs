@@ -75,7 +75,7 @@ pub use channel::{check_query_channel, check_query_channel_only, check_query_cha
 pub use check::{Check, Subject};
 pub use environment::{check_environment, check_environment_only, check_environment_with};
 pub use generated::assert_conforms;
-pub use options::CheckOptions;
+pub use options::{CheckOptions, MAX_CHECK_STEPS};
 pub use policy::{check_policy, check_policy_only, check_policy_with};
 pub use workload::{
     check_workload_model, check_workload_model_built_only, check_workload_model_built_with,

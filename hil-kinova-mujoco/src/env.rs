@@ -41,7 +41,8 @@ pub struct KinovaFeedingConfig {
     /// The items of one episode, in order (`banana`, `carrot`, `cantaloupe`).
     #[serde(default = "default_plate")]
     pub plate: Vec<String>,
-    /// Dimension of the contexts.
+    /// Dimension of the contexts, at most
+    /// [`hil_config::limits::CONTEXT_DIM`].
     #[serde(default = "default_dim")]
     pub context_dim: usize,
     /// Seed of the fixed feature embedding.
@@ -181,8 +182,6 @@ impl KinovaFeedingConfig {
     }
 }
 
-/// Largest `context_dim` a Kinova config may ask for.
-pub const MAX_CONTEXT_DIM: u64 = 4096;
 /// Most `pretraining_trials` per (food, action) a Kinova config may ask for.
 pub const MAX_PRETRAINING_TRIALS: u64 = 10_000;
 
@@ -193,9 +192,9 @@ impl EnvironmentConfig for KinovaFeedingConfig {
     /// error names the file, line and field) and again by
     /// [`KinovaFeedingEnv::new`].
     fn validate(&self) -> Result<()> {
-        use hil_config::limits::{ITEMS_PER_EPISODE, check_at_most, check_count};
+        use hil_config::limits::{CONTEXT_DIM, ITEMS_PER_EPISODE, check_at_most, check_count};
         check_count("plate", self.plate.len(), ITEMS_PER_EPISODE)?;
-        check_count("context_dim", self.context_dim, MAX_CONTEXT_DIM)?;
+        check_count("context_dim", self.context_dim, CONTEXT_DIM)?;
         check_at_most("settings", self.settings.len(), ITEMS_PER_EPISODE)?;
         check_at_most(
             "pretrain_foods",

@@ -72,8 +72,7 @@ pub use calibrate::{
 pub use controller::{Action, PitchFamily, RollBy, actions};
 #[cfg(feature = "physics")]
 pub use env::{
-    KinovaFeedingConfig, KinovaFeedingEnv, MAX_CONTEXT_DIM, MAX_PRETRAINING_TRIALS,
-    simulated_pretraining,
+    KinovaFeedingConfig, KinovaFeedingEnv, MAX_PRETRAINING_TRIALS, simulated_pretraining,
 };
 #[cfg(feature = "physics")]
 pub use error::KinovaError;

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use hil_config::{BuildContext, TaskContext};
+use hil_config::{BuildContext, TaskContext, limits};
 use hil_config::{EnvironmentConfig, PolicyConfig, QueryChannelConfig, WorkloadModelConfig};
 use hil_core::{
     ActionSpace, ArmId, Attempt, Choice, Context, Decision, DecisionInput, Environment, Feedback,
@@ -64,10 +64,15 @@ parse_config!(environment_config, EnvironmentConfig);
 parse_config!(workload_config, WorkloadModelConfig);
 parse_config!(channel_config, QueryChannelConfig);
 
-/// `actions` as an action space: a count (`a0`, `a1`, ...) or names.
-fn action_space(actions: &Bound<'_, PyAny>) -> PyResult<ActionSpace> {
+/// `actions` as an action space: a count (`a0`, `a1`, ...; at most
+/// [`limits::ARMS`], checked before the names are made, so `10**12` is an
+/// error) or names.
+pub(crate) fn action_space(actions: &Bound<'_, PyAny>) -> PyResult<ActionSpace> {
     let names: Vec<String> = match actions.extract::<usize>() {
-        Ok(n) => (0..n).map(|i| format!("a{i}")).collect(),
+        Ok(n) => {
+            limits::check_count("actions", n, limits::ARMS).py_err()?;
+            (0..n).map(|i| format!("a{i}")).collect()
+        }
         Err(_) => actions.extract()?,
     };
     ActionSpace::new(names).py_err()

@@ -11,11 +11,11 @@ use hil_conformance::{
     CheckOptions, ConformanceFailure, ConformanceReport, check_environment_with, check_policy_with,
     check_query_channel_with, check_workload_model_with,
 };
-use hil_core::{ActionSpace, Result};
+use hil_core::Result;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::components::{channel_arg, environment_arg, policy_arg, workload_arg};
+use crate::components::{action_space, channel_arg, environment_arg, policy_arg, workload_arg};
 use crate::errors::{ConformanceError, IntoPy, from_py_err};
 
 /// The report as a dict: `subject`, `passed` (check names), `skipped`
@@ -57,16 +57,12 @@ fn finish(
     }
 }
 
+/// The options over `actions` (a count or names, as for a policy) and
+/// `dim`, unvalidated: the caller sets the rest, then validates once.
 fn options(actions: &Bound<'_, PyAny>, dim: usize) -> PyResult<CheckOptions> {
-    let names: Vec<String> = match actions.extract::<usize>() {
-        Ok(n) => (0..n).map(|i| format!("a{i}")).collect(),
-        Err(_) => actions.extract()?,
-    };
-    let opts = CheckOptions::default()
-        .with_actions(ActionSpace::new(names).py_err()?)
-        .with_context_dim(dim);
-    opts.validate().py_err()?;
-    Ok(opts)
+    Ok(CheckOptions::default()
+        .with_actions(action_space(actions)?)
+        .with_context_dim(dim))
 }
 
 /// Calls `factory` with the build facts of `opts` and converts the result.
@@ -107,6 +103,7 @@ pub(crate) fn check_policy(
         Some(a) => options(a, dim)?,
         None => options(&6usize.into_pyobject(py)?.into_any(), dim)?,
     };
+    opts.validate().py_err()?;
     let r = py.detach(|| check_policy_with(&|| make(&factory, true, &opts, policy_arg), &opts));
     finish(py, r)
 }
@@ -121,7 +118,8 @@ pub(crate) fn check_environment(
     factory: Py<PyAny>,
     attempts: u32,
 ) -> PyResult<Py<PyAny>> {
-    let opts = CheckOptions::default().with_attempts(attempts.max(1));
+    let opts = CheckOptions::default().with_attempts(attempts);
+    opts.validate().py_err()?;
     let r = py.detach(|| {
         check_environment_with(
             &|| make(&factory, false, &opts, |o| environment_arg(o).map(|e| e.0)),
@@ -158,7 +156,8 @@ pub(crate) fn check_query_channel(
         Some(a) => options(a, dim)?,
         None => options(&6usize.into_pyobject(py)?.into_any(), dim)?,
     }
-    .with_queries(queries.max(1));
+    .with_queries(queries);
+    opts.validate().py_err()?;
     let r = py.detach(|| {
         check_query_channel_with(
             &|| make(&factory, true, &opts, |o| channel_arg(Some(o))),

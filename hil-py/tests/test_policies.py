@@ -80,6 +80,23 @@ def test_bad_hyperparameters_raise_invalid_parameter_naming_it(make, name):
     assert e.value.kind == "InvalidParameter"
 
 
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"actions": 6, "dim": 2**62}, "dim"),
+        ({"actions": 6, "dim": 8193}, "dim"),
+        ({"actions": 6, "dim": 0}, "dim"),
+        ({"actions": 10**12, "dim": D}, "actions"),
+        ({"actions": 0, "dim": D}, "actions"),
+    ],
+)
+def test_sizes_outside_their_limits_are_refused_before_allocating(kwargs, name):
+    # A huge dimension or action count used to hang or abort the interpreter.
+    with pytest.raises(hil.InvalidParameterError) as e:
+        hil.LinUCB(alpha=1.0, **kwargs)
+    assert e.value.name == name
+
+
 def test_an_unknown_keyword_or_type_is_refused():
     with pytest.raises(hil.SerdeError):
         hil.LinUCB(actions=6, dim=D, alhpa=0.3)

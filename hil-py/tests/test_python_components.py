@@ -58,6 +58,24 @@ class NonDeterministicWorkload(StepWorkload):
         return float(np.random.random())
 
 
+@pytest.mark.parametrize(
+    "check, kwargs, name",
+    [
+        (lambda **kw: hil.testing.check_query_channel(OracleChannel, **kw), {"queries": 0}, "queries"),
+        (lambda **kw: hil.testing.check_query_channel(OracleChannel, **kw), {"queries": 2**62}, "queries"),
+        (lambda **kw: hil.testing.check_environment(TwoItemEnv, **kw), {"attempts": 0}, "attempts"),
+        (lambda **kw: hil.testing.check_environment(TwoItemEnv, **kw), {"attempts": 1001}, "attempts"),
+        (lambda **kw: hil.testing.check_policy(MeanPolicy, **kw), {"dim": 2**62}, "context_dim"),
+        (lambda **kw: hil.testing.check_policy(MeanPolicy, **kw), {"actions": 10**12}, "actions"),
+    ],
+)
+def test_check_options_outside_their_limits_are_refused(check, kwargs, name):
+    # 0 used to be silently read as 1, and a huge count ran for ever.
+    with pytest.raises(hil.InvalidParameterError) as e:
+        check(**kwargs)
+    assert e.value.name == name
+
+
 def test_a_broken_python_workload_model_fails_the_named_check():
     with pytest.raises(hil.ConformanceError) as e:
         hil.testing.check_workload_model(NonDeterministicWorkload)

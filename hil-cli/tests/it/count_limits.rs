@@ -23,6 +23,20 @@ fn counts_outside_their_limits_name_the_flag() {
     for flag in ["--dim", "--arms", "--steps", "--pretrain"] {
         refused(&["bench", "policy", "--policy", "linucb", flag, HUGE], flag);
     }
+    // The options are checked before the library is opened.
+    for (flag, value) in [
+        ("--dim", HUGE),
+        ("--dim", "8193"),
+        ("--queries", HUGE),
+        ("--queries", "0"),
+        ("--attempts", "0"),
+        ("--attempts", "1001"),
+    ] {
+        refused(
+            &["plugins", "check", "no-such-plugin.so", flag, value],
+            flag,
+        );
+    }
     let out = std::env::temp_dir().join(format!("hil-count-limits-{}", std::process::id()));
     let out = out.to_str().unwrap();
     refused(&["data", "generate", "--out", out, "--dim", HUGE], "dim");

@@ -297,3 +297,31 @@ hil_conformance::conformance_tests! {
         make: |_opts| broken::query_channel(None),
     }
 }
+
+#[test]
+fn options_outside_their_limits_are_a_build_failure_naming_the_option() {
+    let build = |r: Run, name: &str| {
+        let e = r.expect_err(name);
+        assert_eq!(e.check, Check::Build, "{e}");
+        assert!(e.detail.contains(name), "{e}");
+    };
+    // Zero was silently read as one; a 20-digit count ran for ever.
+    let ch = || broken::query_channel(None);
+    for n in [0, usize::MAX] {
+        build(
+            check_query_channel_with(&ch, &options().with_queries(n)),
+            "queries",
+        );
+    }
+    let mut one = broken::query_channel(None).unwrap();
+    build(
+        hil_conformance::check_query_channel(one.as_mut(), 0),
+        "queries",
+    );
+    let env = || broken::environment(None);
+    build(hil_conformance::check_environment(&env, 0), "attempts");
+    build(hil_conformance::check_environment(&env, 1001), "attempts");
+    let opts = options().with_context_dim(usize::MAX);
+    let p = || broken::policy(None, &opts);
+    build(check_policy_with(&p, &opts), "context_dim");
+}

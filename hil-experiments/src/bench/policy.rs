@@ -146,11 +146,6 @@ impl WorkloadModel for PerQuery {
 /// Default length of the bandwidth probe: 256 MiB.
 const PROBE_BYTES: usize = 256 << 20;
 
-/// Most context dimensions a policy benchmark takes (the paper's features
-/// have 2048).
-pub const MAX_DIM: u64 = 8192;
-/// Most arms a policy benchmark takes.
-pub const MAX_ARMS: u64 = 1024;
 /// Most pretraining rounds a policy benchmark takes.
 pub const MAX_PRETRAIN: u64 = 1_000_000;
 /// Most timed steps a policy benchmark takes.
@@ -165,9 +160,10 @@ impl PolicyBench {
     /// naming the flag: a 20-digit `--dim` is an error, not a capacity
     /// overflow.
     fn check_sizes(&self) -> Result<()> {
-        use hil_config::limits::{check_at_most, check_count};
-        check_count("--dim", self.dim, MAX_DIM)?;
-        check_count("--arms", self.arms, MAX_ARMS)?;
+        use hil_config::limits::{ARMS, CONTEXT_DIM, check_at_most, check_count};
+        // The estimator's own limits, checked here too so the error names the flag.
+        check_count("--dim", self.dim, CONTEXT_DIM)?;
+        check_count("--arms", self.arms, ARMS)?;
         check_count("--steps", self.steps, MAX_STEPS)?;
         check_at_most("--pretrain", self.pretrain, MAX_PRETRAIN)?;
         // Each factor is bounded above, so the products cannot overflow.

@@ -133,20 +133,11 @@ impl LinearArms {
         lambda: f64,
         options: EstimatorOptions,
     ) -> Result<Self> {
-        if n_arms == 0 {
-            return Err(HilError::invalid_parameter(
-                "n_arms",
-                n_arms,
-                "an estimator needs at least one arm",
-            ));
-        }
-        if dim == 0 {
-            return Err(HilError::invalid_parameter(
-                "dim",
-                dim,
-                "contexts need at least one dimension",
-            ));
-        }
+        // Checked before anything is allocated: a dense arm holds a d × d
+        // factor, so a 20-digit `dim` must be an error, not an abort.
+        use hil_config::limits::{ARMS, CONTEXT_DIM, check_count};
+        check_count("n_arms", n_arms, ARMS)?;
+        check_count("dim", dim, CONTEXT_DIM)?;
         check_lambda(lambda)?;
         options.validate()?;
         let mut me = Self {

@@ -192,6 +192,12 @@ fn bad_input_is_an_error_naming_the_value() {
     assert_eq!(parameter(LinearArms::new(2, 3, -1.0)), "lambda");
     assert_eq!(parameter(LinearArms::new(2, 3, f64::NAN)), "lambda");
     assert_eq!(parameter(LinearArms::new(0, 3, 1.0)), "n_arms");
+    assert_eq!(parameter(LinearArms::new(1025, 3, 1.0)), "n_arms");
+    assert_eq!(parameter(LinearArms::new(2, 0, 1.0)), "dim");
+    assert_eq!(parameter(LinearArms::new(2, 8193, 1.0)), "dim");
+    // A 20-digit dimension is refused before any allocation.
+    assert_eq!(parameter(LinearArms::new(2, usize::MAX, 1.0)), "dim");
+    assert!(LinearArms::new(1024, 8192, 1.0).is_ok());
     let bad = EstimatorOptions {
         crossover: 0.0,
         ..Default::default()

@@ -21,6 +21,7 @@
 //! | [`TIMESTEPS`] | 1 000 000 | the last timestep of a workload rollout and of its query schedule |
 //! | [`TRIALS`] | 1 000 000 | trials per food and action of a simulated calibration (`--trials`) |
 //! | [`CONTEXT_DIM`] | 8 192 | the context dimension of a linear policy's estimator, a Kinova scene, a conformance check and `hil bench policy --dim` |
+//! | [`HISTORY`] | 360 | a Granger workload model's history H (lags of Δt = 10 s), `--history`, a selection's `histories` |
 //! | [`ARMS`] | 1 024 | the arms of a linear policy's estimator and of `hil bench policy --arms` |
 //!
 //! Component crates call [`check_count`] (a count that must be at least 1)
@@ -80,6 +81,11 @@ pub const TRIALS: u64 = 1_000_000;
 /// at this limit an arm takes 256 MiB; a 20-digit dimension is an error
 /// naming the field, not an allocation that aborts the process.
 pub const CONTEXT_DIM: u64 = 8192;
+
+/// Longest history H of a Granger workload model, in lags of Δt = 10 s
+/// (one hour; the paper tries 1 to 30). A fit's design has 9·H + 2
+/// columns, so a 6-digit H asked for terabytes.
+pub const HISTORY: u64 = 360;
 
 /// Most arms (actions a linear estimator keeps a model for; the paper's
 /// task has six).

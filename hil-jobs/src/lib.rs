@@ -49,18 +49,33 @@ impl Default for Runner {
 /// on the calling thread's stack and overflows 2 MiB).
 pub const WORKER_STACK_BYTES: usize = 8 << 20;
 
+/// Most worker threads a runner starts: a `--threads` typo of many digits
+/// is an error naming `threads`, not thousands of threads spawned until
+/// the system refuses one.
+pub const MAX_THREADS: usize = 1024;
+
 impl Runner {
-    /// A runner on `threads` workers; 0 means rayon's default pool
-    /// (`RAYON_NUM_THREADS`, else one worker per core).
+    /// A runner on `threads` workers (at most [`MAX_THREADS`]); 0 means
+    /// rayon's default pool (`RAYON_NUM_THREADS`, else one worker per core).
     ///
     /// ```
     /// use hil_jobs::Runner;
+    /// use hil_core::HilError;
     /// assert_eq!(Runner::new(3).unwrap().threads(), 3);
     /// assert!(Runner::new(0).unwrap().threads() >= 1);
+    /// let err = Runner::new(100_000).unwrap_err();
+    /// assert!(matches!(err, HilError::InvalidParameter { ref name, .. } if name == "threads"));
     /// ```
     pub fn new(threads: usize) -> Result<Self> {
         if threads == 0 {
             return Ok(Self::default());
+        }
+        if threads > MAX_THREADS {
+            return Err(HilError::invalid_parameter(
+                "threads",
+                threads,
+                format!("must be between 0 (one per core) and {MAX_THREADS}"),
+            ));
         }
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -14,6 +14,7 @@
 use hil_jobs::Runner;
 use std::fmt::Write as _;
 
+use hil_config::limits;
 use hil_core::{HilError, QueryHistory, Result};
 use hil_stats::{mean, mean_std, median};
 use rand::SeedableRng;
@@ -68,12 +69,15 @@ impl SelectOptions {
                 "need at least 2 outer and 2 inner folds",
             ));
         }
-        if self.histories.is_empty() || self.histories.contains(&0) {
+        if self.histories.is_empty() {
             return Err(HilError::invalid_parameter(
                 "histories",
-                format!("{:?}", self.histories),
+                "[]",
                 "need at least one H ≥ 1",
             ));
+        }
+        for (i, &h) in self.histories.iter().enumerate() {
+            limits::check_count(&format!("histories[{i}]"), h, limits::HISTORY)?;
         }
         if self.lambdas.is_empty() || self.lambdas.iter().any(|l| !(l.is_finite() && *l >= 0.0)) {
             return Err(HilError::invalid_parameter(
@@ -145,17 +149,16 @@ impl Candidate {
     /// `granger`, `granger_n`, `granger_r`, `granger_rn`, `granger_sim`
     /// (Granger needs `h`; `granger_sim` defaults to H = 10).
     pub fn parse(name: &str, h: Option<usize>) -> Result<Self> {
-        let granger = |variant, default: Option<usize>| {
-            h.or(default)
-                .filter(|h| *h >= 1)
-                .map(|h| Self::Granger { variant, h })
-                .ok_or_else(|| {
-                    HilError::invalid_parameter(
-                        "history",
-                        h.map_or("(missing)".to_string(), |h| h.to_string()),
-                        "Granger models need --history H ≥ 1",
-                    )
-                })
+        let granger = |variant, default: Option<usize>| match h.or(default) {
+            Some(h) => {
+                limits::check_count("history", h, limits::HISTORY)?;
+                Ok(Self::Granger { variant, h })
+            }
+            None => Err(HilError::invalid_parameter(
+                "history",
+                "(missing)",
+                "Granger models need --history H ≥ 1",
+            )),
         };
         match name {
             "constant" => Ok(Self::Constant),
@@ -798,5 +801,31 @@ mod tests {
         for cand in Candidate::table(&[1, 5]).into_iter().chain([sim]) {
             assert_eq!(Candidate::parse(cand.key(), cand.history()).unwrap(), cand);
         }
+    }
+
+    /// A history outside `1..=limits::HISTORY` is refused before a design of
+    /// 9·H + 2 columns is allocated (H = 100 000 asked for terabytes).
+    #[test]
+    fn histories_outside_the_limit_are_refused_naming_them() {
+        let name = |e: HilError| match e {
+            HilError::InvalidParameter { name, .. } => name,
+            other => panic!("{other:?}"),
+        };
+        for h in [None, Some(0), Some(361), Some(usize::MAX)] {
+            let e = Candidate::parse("granger", h).unwrap_err();
+            assert_eq!(name(e), "history");
+        }
+        assert!(Candidate::parse("granger", Some(360)).is_ok());
+        let opts = |histories: Vec<usize>| SelectOptions {
+            histories,
+            ..SelectOptions::default()
+        };
+        assert_eq!(
+            name(opts(vec![1, 100_000]).validate().unwrap_err()),
+            "histories[1]"
+        );
+        assert_eq!(name(opts(vec![0]).validate().unwrap_err()), "histories[0]");
+        assert_eq!(name(opts(vec![]).validate().unwrap_err()), "histories");
+        assert!(opts(vec![1, 30]).validate().is_ok());
     }
 }

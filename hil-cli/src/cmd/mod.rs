@@ -30,9 +30,19 @@ pub struct Threads {
 }
 
 impl Threads {
-    /// The runner of this many threads.
+    /// The runner of this many threads; past
+    /// [`hil_jobs::MAX_THREADS`], an error naming `--threads`.
     pub fn runner(self) -> hil_core::Result<hil_jobs::Runner> {
-        hil_jobs::Runner::new(self.threads)
+        hil_jobs::Runner::new(self.threads).map_err(|e| match e {
+            hil_core::HilError::InvalidParameter { value, why, .. } => {
+                hil_core::HilError::InvalidParameter {
+                    name: "--threads".into(),
+                    value,
+                    why,
+                }
+            }
+            other => other,
+        })
     }
 }
 

@@ -246,9 +246,10 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
             name,
             cv,
         } => {
-            let study = Study::load(&data)?;
+            // The flags first: a bad one is named before the data is read.
             let id = DatasetId::parse(&population)?;
             let cand = Candidate::parse(&model, history)?;
+            let study = Study::load(&data)?;
             let m = fit_study_model(&study, id, cand, &cv.options(), name)?;
             m.save(&out)?;
             outln!(

@@ -23,6 +23,31 @@ fn counts_outside_their_limits_name_the_flag() {
     for flag in ["--dim", "--arms", "--steps", "--pretrain"] {
         refused(&["bench", "policy", "--policy", "linucb", flag, HUGE], flag);
     }
+    refused(
+        &["reproduce", "--quick", "--threads", "100000"],
+        "--threads",
+    );
+    refused(
+        &[
+            "workload",
+            "fit",
+            "--data",
+            "no-such.csv",
+            "--population",
+            "d1",
+        ]
+        .into_iter()
+        .chain([
+            "--model",
+            "granger",
+            "--history",
+            "100000",
+            "--out",
+            "x.json",
+        ])
+        .collect::<Vec<_>>(),
+        "history",
+    );
     // The options are checked before the library is opened.
     for (flag, value) in [
         ("--dim", HUGE),

@@ -169,14 +169,12 @@ impl GrangerModel {
 
     /// Checks shapes and finiteness (and bounds for constrained variants).
     pub fn validate(&self) -> Result<()> {
-        if self.history == 0 || self.weights.len() != self.history {
+        hil_config::limits::check_count("history", self.history, hil_config::limits::HISTORY)?;
+        if self.weights.len() != self.history {
             return Err(HilError::invalid_parameter(
                 "history",
                 self.history,
-                format!(
-                    "must be ≥ 1 and match the {} weight rows",
-                    self.weights.len()
-                ),
+                format!("must match the {} weight rows", self.weights.len()),
             ));
         }
         let (lower, upper) = self.variant.bounds(self.history);

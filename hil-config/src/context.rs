@@ -83,6 +83,21 @@ impl TaskContext {
         self.pretraining.as_ref()
     }
 
+    /// The pretraining data for a policy whose config asks for it
+    /// (`pretrain = true`); without any, an error naming `pretrain` that
+    /// says how an environment comes to offer some.
+    pub fn required_pretraining(&self) -> Result<&Arc<[LabelledObservation]>> {
+        self.pretraining().ok_or_else(|| {
+            HilError::invalid_parameter(
+                "pretrain",
+                true,
+                "pretraining was requested but the environment offers no pretraining data: \
+                 configure the environment to offer some (`pretraining_trials` of a \
+                 `kinova_feeding` environment, `pretrain_foods` of a `food_replay` one), or set `pretrain = false`",
+            )
+        })
+    }
+
     /// Resolves `path` against the config's directory unless it is absolute.
     pub fn resolve(&self, path: &Path) -> PathBuf {
         self.base.resolve(path)

@@ -65,14 +65,22 @@ impl Distraction {
 /// The default is the paper's simulation default: an easy multiple-choice
 /// question with no distraction.
 ///
+/// It is written as a table of its fields, and read from one or from its
+/// text form (`"open_ended/hard"`, see [`FromStr`](std::str::FromStr)), so
+/// a config may say `query_kind = "bounding_box/hard/easy"`.
+///
 /// ```
 /// use hil_core::{QueryKind, ResponseType, Difficulty, Distraction};
 /// let k = QueryKind::default();
 /// assert_eq!((k.response, k.difficulty, k.distraction),
 ///            (ResponseType::Mcq, Difficulty::Easy, Distraction::None));
+/// let text: QueryKind = serde_json::from_str(r#""open_ended/hard""#).unwrap();
+/// let table: QueryKind =
+///     serde_json::from_str(r#"{"response": "open_ended", "difficulty": "hard"}"#).unwrap();
+/// assert_eq!(text, table);
+/// assert!(serde_json::from_str::<QueryKind>(r#""mcq/medium""#).is_err());
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
 pub struct QueryKind {
     /// How the person answers.
     pub response: ResponseType,
@@ -80,6 +88,47 @@ pub struct QueryKind {
     pub difficulty: Difficulty,
     /// What else the person is doing.
     pub distraction: Distraction,
+}
+
+/// The table form of [`QueryKind`], read with serde's own checks (unknown
+/// fields refused, missing ones defaulted).
+#[derive(Default, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct QueryKindTable {
+    response: ResponseType,
+    difficulty: Difficulty,
+    distraction: Distraction,
+}
+
+impl<'de> Deserialize<'de> for QueryKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Either;
+        impl<'de> serde::de::Visitor<'de> for Either {
+            type Value = QueryKind;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(
+                    "a query kind: text `response/difficulty/distraction` \
+                     (e.g. \"mcq/easy/none\") or a table of those fields",
+                )
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> std::result::Result<QueryKind, E> {
+                s.parse().map_err(E::custom)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> std::result::Result<QueryKind, A::Error> {
+                let t =
+                    QueryKindTable::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(QueryKind {
+                    response: t.response,
+                    difficulty: t.difficulty,
+                    distraction: t.distraction,
+                })
+            }
+        }
+        d.deserialize_any(Either)
+    }
 }
 
 /// One spelling per variant, shared by `Display` and `FromStr` (and so by

@@ -237,16 +237,21 @@ impl<'a> WorkloadForecast<'a> {
         self.history
     }
 
-    /// The predicted WL_t if a query of `kind` were asked now.
+    /// The predicted WL_t if a query of `kind` were asked now; a
+    /// non-finite prediction is an error naming the model.
     pub fn if_queried(&self, kind: QueryKind) -> Result<f64> {
-        self.model()?
-            .predict_if_queried(&WorkloadInput::new(self.wl0, self.history, self.t), kind)
+        let model = self.model()?;
+        let wl =
+            model.predict_if_queried(&WorkloadInput::new(self.wl0, self.history, self.t), kind)?;
+        finite_prediction(model, wl, self.t)
     }
 
-    /// The predicted WL_t without a query now.
+    /// The predicted WL_t without a query now; a non-finite prediction is
+    /// an error naming the model.
     pub fn now(&self) -> Result<f64> {
-        self.model()?
-            .predict(&WorkloadInput::new(self.wl0, self.history, self.t))
+        let model = self.model()?;
+        let wl = model.predict(&WorkloadInput::new(self.wl0, self.history, self.t))?;
+        finite_prediction(model, wl, self.t)
     }
 
     fn model(&self) -> Result<&'a dyn WorkloadModel> {
@@ -284,13 +289,19 @@ pub fn workload_at(
         return Ok(wl0);
     }
     let wl = model.predict(&WorkloadInput::new(wl0, history, t))?;
-    if !wl.is_finite() {
-        return Err(HilError::invalid_input(
-            format!("workload prediction of `{}`", model.name()),
-            format!("{wl} is not finite at t = {t}"),
-        ));
+    finite_prediction(model, wl, t)
+}
+
+/// `wl`, `model`'s prediction at `t`, if finite: a NaN must never reach a
+/// threshold comparison (where it would silently mean "do not ask").
+fn finite_prediction(model: &dyn WorkloadModel, wl: f64, t: Timestep) -> Result<f64> {
+    if wl.is_finite() {
+        return Ok(wl);
     }
-    Ok(wl)
+    Err(HilError::invalid_input(
+        format!("workload prediction of `{}`", model.name()),
+        format!("{wl} is not finite at t = {t}"),
+    ))
 }
 
 /// Tracks the workload of one person through a session: the queries asked

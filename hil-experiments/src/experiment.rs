@@ -87,9 +87,11 @@ impl Experiment {
         observers: &mut [&mut dyn SessionObserver],
         mut on_episode: impl FnMut(usize, &EpisodeReport),
     ) -> Result<ExperimentSummary> {
-        // An experiment built in code skips the config's check: repeat it
-        // before the allocation it bounds.
+        // An experiment built in code (hil-py's run_session) skips the
+        // config's checks: repeat them before the work they bound.
         hil_config::limits::check_count("episodes", self.episodes, hil_config::limits::EPISODES)?;
+        self.settings.validate()?;
+        hil_config::check_session_limits(&self.settings)?;
         let mut metrics = Vec::with_capacity(self.episodes);
         for k in 0..self.episodes {
             let seed = self.episode_seed(k);

@@ -966,6 +966,29 @@ impl Protocol {
         let method = s.methods.get(key.method).ok_or_else(|| {
             HilError::invalid_parameter("method", key.method, "no method at that index")
         })?;
+        // A key from outside `jobs()` (hil-py's protocol_run_json takes
+        // JSON) must name a run this protocol has.
+        let index = |name: &str, i: usize, n: usize, what: &str| {
+            if i < n {
+                Ok(())
+            } else {
+                Err(HilError::invalid_parameter(
+                    name,
+                    i,
+                    format!("this protocol has {n} {what} (indices from 0)"),
+                ))
+            }
+        };
+        index("seed", key.seed, s.seeds_run(), "environment seeds")?;
+        index(
+            "policy_seed",
+            key.policy_seed,
+            s.n_policy_seeds,
+            "policy seeds",
+        )?;
+        if let Some(d) = key.decide_model {
+            index("decide_model", d, self.models.len(), "workload models")?;
+        }
         let (label, seeds) = self.seeds(key);
         let mut env = self.environment.build(&EpisodeSpec {
             dataset: &self.dataset,

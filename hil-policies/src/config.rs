@@ -90,13 +90,7 @@ impl EstimatorConfig {
         if !self.pretrain {
             return LinearArms::with_options(n_arms, dim, self.lambda, self.estimator);
         }
-        let data = ctx.pretraining().ok_or_else(|| {
-            HilError::invalid_parameter(
-                "pretrain",
-                true,
-                "pretraining was requested but the environment offers no pretraining data",
-            )
-        })?;
+        let data = ctx.required_pretraining()?;
         // A protocol builds hundreds of policies from one context: pretrain
         // each distinct estimator once and clone it (the clone is exact).
         let key = format!(

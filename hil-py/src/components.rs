@@ -944,27 +944,19 @@ impl PyWorkloadHandle {
         wl0: f64,
         kinds: Option<Vec<String>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        hil_core::workload::check_wl0(wl0).py_err()?;
         let kinds = kinds_of(kinds, query_times.len())?;
-        let end = steps.unwrap_or(query_times.iter().max().copied().unwrap_or(0) + 10);
-        let mut order: Vec<(u64, QueryKind)> = query_times.into_iter().zip(kinds).collect();
-        order.sort_by_key(|q| q.0);
+        // Any order here; `schedule[i]` in an error counts in time order.
+        let mut schedule: Vec<(u64, QueryKind)> = query_times.into_iter().zip(kinds).collect();
+        schedule.sort_by_key(|q| q.0);
+        let end = steps.unwrap_or_else(|| hil_workload::rollout::default_end(&schedule));
         let model = self.inner.clone();
         let curve = py
-            .detach(|| -> Result<Vec<f64>> {
-                let mut h = QueryHistory::new();
-                let mut next = order.into_iter().peekable();
-                let mut out = Vec::with_capacity(end as usize + 1);
-                for t in 0..=end {
-                    while let Some((_, kind)) = next.next_if(|q| q.0 == t) {
-                        h.push(t, kind)?;
-                    }
-                    out.push(hil_core::workload::workload_at(model.as_ref(), wl0, &h, t)?);
-                }
-                Ok(out)
-            })
+            .detach(|| hil_workload::rollout::rollout(model.as_ref(), wl0, &schedule, end))
             .py_err()?;
-        Ok(PyArray1::from_vec(py, curve))
+        Ok(PyArray1::from_vec(
+            py,
+            curve.into_iter().map(|s| s.wl).collect(),
+        ))
     }
 
     fn __repr__(&self) -> String {

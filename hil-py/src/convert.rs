@@ -41,7 +41,29 @@ pub(crate) fn from_py<T: DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -
 /// state, or a NaN / infinite float) is refused with an error naming its
 /// key (`what.key[2].key`), never turned silently into a float.
 pub(crate) fn to_value(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Value> {
+    value_at(obj, what, 0)
+}
+
+/// Deepest nesting of plain data read from Python: far beyond any config
+/// or result, and low enough that a list holding itself, or an object
+/// whose `tolist()` returns itself, is an error naming its key instead of
+/// a stack overflow that kills the interpreter.
+const MAX_DEPTH: usize = 128;
+
+/// The error for data nested past [`MAX_DEPTH`] at `what`, if `depth` is.
+fn check_depth(what: &str, depth: usize) -> PyResult<()> {
+    if depth <= MAX_DEPTH {
+        return Ok(());
+    }
+    Err(crate::errors::to_py_err(HilError::invalid_input(
+        what,
+        format!("nested more than {MAX_DEPTH} levels deep (does a list or dict contain itself?)"),
+    )))
+}
+
+fn value_at(obj: &Bound<'_, PyAny>, what: &str, depth: usize) -> PyResult<Value> {
     use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+    check_depth(what, depth)?;
     let refuse = |why: String| Err(crate::errors::to_py_err(HilError::invalid_input(what, why)));
     if obj.is_none() {
         return Ok(Value::Null);
@@ -77,7 +99,7 @@ pub(crate) fn to_value(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Value> {
             let Ok(key) = k.extract::<String>() else {
                 return refuse(format!("the key {k} is not a str (JSON keys are strings)"));
             };
-            let value = to_value(&v, &format!("{what}.{key}"))?;
+            let value = value_at(&v, &format!("{what}.{key}"), depth + 1)?;
             map.insert(key, value);
         }
         return Ok(Value::Object(map));
@@ -86,13 +108,13 @@ pub(crate) fn to_value(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Value> {
         let items = obj
             .try_iter()?
             .enumerate()
-            .map(|(i, v)| to_value(&v?, &format!("{what}[{i}]")))
+            .map(|(i, v)| value_at(&v?, &format!("{what}[{i}]"), depth + 1))
             .collect::<PyResult<Vec<_>>>()?;
         return Ok(Value::Array(items));
     }
     // NumPy scalars and arrays: through their Python form.
     if obj.hasattr("tolist")? {
-        return to_value(&obj.call_method0("tolist")?, what);
+        return value_at(&obj.call_method0("tolist")?, what, depth + 1);
     }
     refuse(format!(
         "a {} is not plain data (use None, bool, int, float, str, list or dict)",
@@ -160,7 +182,7 @@ pub(crate) fn array<'py>(py: Python<'py>, context: &Context) -> Bound<'py, PyArr
 /// read in (unlike JSON, TOML holds NaN and infinities, so a bad float
 /// reaches the parameter's own validation and its error names it).
 pub(crate) fn to_toml(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<toml::Value> {
-    toml_of(obj, what, false)
+    toml_of(obj, what, false, 0)
 }
 
 /// Plain Python data that may hold NaN or infinities (a Python policy's
@@ -170,19 +192,32 @@ pub(crate) fn to_toml(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<toml::Valu
 /// `finite diagnostics`) instead of failing as unparsable JSON. A dict
 /// entry that is None is left out (an absent `Option` field is None).
 pub(crate) fn from_py_data<T: DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<T> {
-    T::deserialize(toml_of(obj, what, true)?)
+    T::deserialize(toml_of(obj, what, true, 0)?)
         .map_err(|e| HilError::serde(what, e.message().trim().to_string()))
         .py_err()
 }
 
-/// [`to_toml`]; with `skip_none`, dict entries that are None are left out.
-fn toml_of(obj: &Bound<'_, PyAny>, what: &str, skip_none: bool) -> PyResult<toml::Value> {
+/// [`to_toml`] at nesting `depth`; with `skip_none`, dict entries that are
+/// None are left out.
+fn toml_of(
+    obj: &Bound<'_, PyAny>,
+    what: &str,
+    skip_none: bool,
+    depth: usize,
+) -> PyResult<toml::Value> {
     use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+    check_depth(what, depth)?;
     if obj.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(obj.extract()?));
     }
     if obj.is_instance_of::<PyInt>() {
-        return Ok(toml::Value::Integer(obj.extract()?));
+        return match obj.extract::<i64>() {
+            Ok(i) => Ok(toml::Value::Integer(i)),
+            Err(_) => Err(crate::errors::to_py_err(HilError::invalid_input(
+                what,
+                format!("the int {obj} does not fit in 64 signed bits"),
+            ))),
+        };
     }
     if obj.is_instance_of::<PyFloat>() {
         return Ok(toml::Value::Float(obj.extract()?));
@@ -197,7 +232,7 @@ fn toml_of(obj: &Bound<'_, PyAny>, what: &str, skip_none: bool) -> PyResult<toml
                 continue;
             }
             let key: String = k.extract()?;
-            let value = toml_of(&v, &format!("{what}.{key}"), skip_none)?;
+            let value = toml_of(&v, &format!("{what}.{key}"), skip_none, depth + 1)?;
             t.insert(key, value);
         }
         return Ok(toml::Value::Table(t));
@@ -205,13 +240,13 @@ fn toml_of(obj: &Bound<'_, PyAny>, what: &str, skip_none: bool) -> PyResult<toml
     if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
         let items = obj
             .try_iter()?
-            .map(|v| toml_of(&v?, what, skip_none))
+            .map(|v| toml_of(&v?, what, skip_none, depth + 1))
             .collect::<PyResult<Vec<_>>>()?;
         return Ok(toml::Value::Array(items));
     }
     // NumPy scalars and arrays: through their Python form.
     if obj.hasattr("tolist")? {
-        return toml_of(&obj.call_method0("tolist")?, what, skip_none);
+        return toml_of(&obj.call_method0("tolist")?, what, skip_none, depth + 1);
     }
     Err(crate::errors::to_py_err(HilError::invalid_input(
         what,

@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::{IntoPyDict, PyTuple};
 use serde_json::Value;
 
-use crate::errors::to_py_err;
+use crate::errors::{IntoPy, to_py_err};
 
 /// The key of a Python policy's table that asks for pretraining; hil
 /// consumes it, the factory never sees it.
@@ -45,11 +45,7 @@ pub(crate) fn take_flag(mut params: Value) -> Result<(Value, bool)> {
 /// such method.
 pub(crate) fn pretrain(policy: &Bound<'_, PyAny>, ctx: &TaskContext) -> PyResult<()> {
     let refuse = |why: String| Err(to_py_err(HilError::invalid_parameter(KEY, true, why)));
-    let Some(data) = ctx.pretraining() else {
-        return refuse(
-            "pretraining was requested but the environment offers no pretraining data".into(),
-        );
-    };
+    let data = ctx.required_pretraining().py_err()?;
     if !policy.hasattr("pretrain")? {
         return refuse(format!(
             "the Python policy {} has no pretrain(contexts, arms, rewards) method: add one, \

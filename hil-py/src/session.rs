@@ -149,7 +149,9 @@ pub(crate) fn run_session(
         .with_n_att(n_att)
         .with_wl0(wl0)
         .with_max_items(max_items);
+    // Before a log is created (Experiment::run checks again for Rust callers).
     settings.validate().py_err()?;
+    hil_config::check_session_limits(&settings).py_err()?;
     let (environment, _) = environment_arg(environment)?;
     let exp = Experiment {
         settings,

@@ -2,7 +2,7 @@
 //! timestep from WL_0, with the queries asked at given timesteps (what `hil
 //! workload rollout` prints and plots).
 
-use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadInput, WorkloadModel};
+use hil_core::{HilError, QueryHistory, QueryKind, Result, Timestep, WorkloadModel};
 
 /// One timestep of a rollout.
 #[derive(Clone, Debug, PartialEq)]
@@ -16,8 +16,14 @@ pub struct RolloutStep {
 }
 
 /// `model`'s workload at every timestep `0..=end` from `wl0`, the queries
-/// of `schedule` (timesteps not decreasing) entering the history at their
-/// timesteps. `end` is at most [`hil_config::limits::TIMESTEPS`].
+/// of `schedule` entering the history at their timesteps; WL_t is
+/// [`hil_core::workload::workload_at`], the session's own (so WL_0 at
+/// t = 0, and a non-finite prediction is an error naming the model).
+///
+/// `end` is at most [`hil_config::limits::TIMESTEPS`] (see
+/// [`default_end`]); the schedule's timesteps must not decrease and must
+/// not pass `end`, else the error names the entry (`schedule[i]`): a query
+/// is never silently dropped.
 ///
 /// ```
 /// use hil_core::QueryKind;
@@ -27,6 +33,7 @@ pub struct RolloutStep {
 /// assert_eq!(steps.len(), 5);
 /// assert_eq!(steps[2].asked, [QueryKind::default()]);
 /// assert!(steps[2].wl > steps[1].wl); // a query raises the workload
+/// assert!(rollout(model.as_ref(), 0.5, &[(5, QueryKind::default())], 4).is_err());
 /// ```
 pub fn rollout(
     model: &dyn WorkloadModel,
@@ -36,8 +43,24 @@ pub fn rollout(
 ) -> Result<Vec<RolloutStep>> {
     hil_core::workload::check_wl0(wl0)?;
     hil_config::limits::check_at_most("steps", end, hil_config::limits::TIMESTEPS)?;
+    let mut prev = 0;
+    for (i, &(t, _)) in schedule.iter().enumerate() {
+        let why = if t < prev {
+            format!("times must not decrease (previous query at {prev})")
+        } else if t > end {
+            format!("timestep {t} is after the rollout's last step, {end}")
+        } else {
+            prev = t;
+            continue;
+        };
+        return Err(HilError::invalid_parameter(
+            format!("schedule[{i}]"),
+            t,
+            why,
+        ));
+    }
     let mut history = QueryHistory::new();
-    let mut steps = Vec::new();
+    let mut steps = Vec::with_capacity(end as usize + 1);
     let mut next = 0;
     for t in 0..=end {
         let mut asked = Vec::new();
@@ -46,10 +69,30 @@ pub fn rollout(
             asked.push(schedule[next].1);
             next += 1;
         }
-        let wl = model.predict(&WorkloadInput::new(wl0, &history, t))?;
+        let wl = hil_core::workload::workload_at(model, wl0, &history, t)?;
         steps.push(RolloutStep { t, wl, asked });
     }
     Ok(steps)
+}
+
+/// The last step of a rollout over `schedule` when none is given: ten
+/// steps (100 s) past the last query, or 10 without queries.
+///
+/// ```
+/// use hil_core::QueryKind;
+/// use hil_workload::rollout::default_end;
+/// assert_eq!(default_end(&[(3, QueryKind::default())]), 13);
+/// assert_eq!(default_end(&[]), 10);
+/// ```
+pub fn default_end(schedule: &[(Timestep, QueryKind)]) -> Timestep {
+    // Saturating: a timestep near u64::MAX must not wrap to a short rollout
+    // (rollout then refuses the end by its limit).
+    schedule
+        .iter()
+        .map(|q| q.0)
+        .max()
+        .unwrap_or(0)
+        .saturating_add(10)
 }
 
 /// Parses a query schedule `t:response/difficulty/distraction,...` (a

@@ -145,14 +145,26 @@ impl Candidate {
         }
     }
 
+    /// Checks a Granger history against `1..=`[`limits::HISTORY`], before
+    /// a design of 9·H + 2 columns is allocated; every fit and
+    /// cross-validation runs it, whichever way the candidate was made
+    /// ([`Candidate::parse`], or deserialised from a selection row).
+    pub fn validate(&self) -> Result<()> {
+        match self.history() {
+            Some(h) => limits::check_count("history", h, limits::HISTORY),
+            None => Ok(()),
+        }
+    }
+
     /// Parses a CLI model name: `constant`, `average`, `exp_impulse`,
     /// `granger`, `granger_n`, `granger_r`, `granger_rn`, `granger_sim`
     /// (Granger needs `h`; `granger_sim` defaults to H = 10).
     pub fn parse(name: &str, h: Option<usize>) -> Result<Self> {
         let granger = |variant, default: Option<usize>| match h.or(default) {
             Some(h) => {
-                limits::check_count("history", h, limits::HISTORY)?;
-                Ok(Self::Granger { variant, h })
+                let cand = Self::Granger { variant, h };
+                cand.validate()?;
+                Ok(cand)
             }
             None => Err(HilError::invalid_parameter(
                 "history",
@@ -160,10 +172,19 @@ impl Candidate {
                 "Granger models need --history H ≥ 1",
             )),
         };
+        // A history given to a model without one is a mistake, not ignored.
+        let historyless = |cand: Self| match h {
+            None => Ok(cand),
+            Some(h) => Err(HilError::invalid_parameter(
+                "history",
+                h,
+                format!("only Granger models have a history, not `{name}`"),
+            )),
+        };
         match name {
-            "constant" => Ok(Self::Constant),
-            "average" => Ok(Self::Average),
-            "exp_impulse" => Ok(Self::ExpImpulse),
+            "constant" => historyless(Self::Constant),
+            "average" => historyless(Self::Average),
+            "exp_impulse" => historyless(Self::ExpImpulse),
             "granger" => granger(GrangerVariant::Plain, None),
             "granger_n" => granger(GrangerVariant::Nonnegative, None),
             "granger_r" => granger(GrangerVariant::Ridge, None),
@@ -478,6 +499,9 @@ pub fn cross_validate(
     opts: &SelectOptions,
 ) -> Result<SelectionTable> {
     opts.validate()?;
+    for c in candidates {
+        c.validate()?;
+    }
     let h_max = candidates
         .iter()
         .filter_map(Candidate::history)
@@ -545,6 +569,7 @@ pub fn fit_on_all(
     opts: &SelectOptions,
 ) -> Result<(ModelSpec, Option<f64>)> {
     opts.validate()?;
+    cand.validate()?;
     let p = Problem::new(
         &dataset.pairs,
         cand.history().unwrap_or(1),
@@ -816,6 +841,16 @@ mod tests {
             assert_eq!(name(e), "history");
         }
         assert!(Candidate::parse("granger", Some(360)).is_ok());
+        assert_eq!(
+            name(Candidate::parse("constant", Some(5)).unwrap_err()),
+            "history"
+        );
+        // However a candidate is made, fitting checks it first.
+        let big = Candidate::Granger {
+            variant: GrangerVariant::Plain,
+            h: 100_000,
+        };
+        assert_eq!(name(big.validate().unwrap_err()), "history");
         let opts = |histories: Vec<usize>| SelectOptions {
             histories,
             ..SelectOptions::default()

@@ -9,7 +9,7 @@ use hil_core::{HilError, Result, Timestep};
 use hil_workload::bundle::{SYNTHETIC_DATA_NOTE, StudySummary, WrittenBundle, write_bundle};
 use hil_workload::datasets::DatasetId;
 use hil_workload::models::FittedModel;
-use hil_workload::rollout::{parse_schedule, rollout};
+use hil_workload::rollout::{default_end, parse_schedule, rollout};
 use hil_workload::select::{Candidate, SelectOptions, fit_study_model, select_study_models};
 use hil_workload::study::Study;
 use hil_workload::synth::SynthConfig;
@@ -273,8 +273,7 @@ pub fn run(args: WorkloadArgs) -> Result<()> {
                 None => FittedModel::load(&model)?,
             };
             let queries = parse_schedule(&schedule)?;
-            let last = queries.last().map_or(0, |q| q.0);
-            let end = steps.unwrap_or(last + 10);
+            let end = steps.unwrap_or_else(|| default_end(&queries));
             let points = rollout(&m, wl0, &queries, end)?;
             outln!("t,seconds,wl,query")?;
             for p in &points {

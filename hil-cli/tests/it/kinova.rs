@@ -325,7 +325,7 @@ fn errors_in_a_study_file_name_file_line_and_field() {
     // line, whichever check refuses it (limits, labels, noise, hold).
     for (i, (key, value)) in [
         ("hold_s", "-1.0"),
-        ("context_dim", "5000"),
+        ("context_dim", "9000"),
         ("plate", "[\"apple\"]"),
         ("settings", "[\"wal\"]"),
     ]

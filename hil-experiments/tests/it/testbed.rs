@@ -233,6 +233,60 @@ fn plots_render_runs() {
     assert_eq!(svg.matches("<polyline").count(), 2);
 }
 
+/// A run key from outside `jobs()` (hil-py takes them as JSON) naming a
+/// seed, policy seed or workload model the protocol does not have is an
+/// error naming the field; an out-of-range model index panicked.
+#[test]
+fn a_run_key_outside_the_protocol_is_refused_naming_the_field() {
+    use hil_core::HilError;
+    let (ds, settings, models) = setup();
+    let p = Protocol::new(settings, ds, models).unwrap();
+    let ctx = p.build_context().unwrap();
+    let jobs = p.jobs().unwrap();
+    let good = jobs
+        .iter()
+        .find(|k| k.decide_model.is_some())
+        .expect("a method that reads the forecast")
+        .clone();
+    let bad = [
+        (
+            "decide_model",
+            RunKey {
+                decide_model: Some(99),
+                ..good.clone()
+            },
+        ),
+        (
+            "seed",
+            RunKey {
+                seed: usize::MAX,
+                ..good.clone()
+            },
+        ),
+        (
+            "policy_seed",
+            RunKey {
+                policy_seed: usize::MAX,
+                ..good.clone()
+            },
+        ),
+        (
+            "method",
+            RunKey {
+                method: 99,
+                ..good.clone()
+            },
+        ),
+    ];
+    for (field, key) in bad {
+        let e = p.run_one(&key, &ctx).unwrap_err();
+        assert!(
+            matches!(&e, HilError::InvalidParameter { name, .. } if name == field),
+            "{field}: {e:?}"
+        );
+    }
+}
+
 /// A grid variant runs only its extra grid values, and is selected over
 /// the same runs: its results choose only among its own values.
 #[test]

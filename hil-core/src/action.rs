@@ -35,13 +35,33 @@ impl std::fmt::Display for ArmId {
 /// // Names are unique and non-empty.
 /// assert!(ActionSpace::new(["push", "grasp_top", "push"]).is_err());
 /// assert!(ActionSpace::new(["push", " "]).is_err());
+/// // Read back, the same checks apply.
+/// assert!(serde_json::from_str::<ActionSpace>(r#"{"names": ["a", "a"]}"#).is_err());
 /// ```
 ///
 /// Tasks define their own spaces (the feeding task's six skewering actions
 /// live with the feeding data in `hil-envs`).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "ActionSpaceFields")]
 pub struct ActionSpace {
     names: Vec<String>,
+}
+
+/// The serde form of [`ActionSpace`], read through [`ActionSpace::new`] so
+/// that deserialised names are checked as built ones are (a query or a log
+/// with a duplicate or empty name is an error, not a space that breaks
+/// lookups).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ActionSpaceFields {
+    names: Vec<String>,
+}
+
+impl TryFrom<ActionSpaceFields> for ActionSpace {
+    type Error = HilError;
+    fn try_from(f: ActionSpaceFields) -> Result<Self> {
+        Self::new(f.names)
+    }
 }
 
 impl ActionSpace {

@@ -174,6 +174,7 @@ spelled!(Distraction, "distraction", None => "none", Easy => "easy", Hard => "ha
 /// // Trailing parts may be left out; they keep their defaults.
 /// assert_eq!("open_ended".parse::<QueryKind>().unwrap().to_string(), "open_ended/easy/none");
 /// assert!("mcq/medium".parse::<QueryKind>().is_err());
+/// assert!("".parse::<QueryKind>().is_err());
 /// ```
 impl std::fmt::Display for QueryKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -190,6 +191,14 @@ impl std::str::FromStr for QueryKind {
     fn from_str(s: &str) -> crate::error::Result<Self> {
         let mut k = QueryKind::default();
         let parts: Vec<&str> = s.split('/').map(str::trim).collect();
+        if parts.iter().all(|p| p.is_empty()) {
+            // "" or "//" names nothing: the default must be asked for.
+            return Err(crate::error::HilError::invalid_parameter(
+                "query kind",
+                format!("`{s}`"),
+                "names no response type (e.g. `mcq`, `mcq/easy/none`)",
+            ));
+        }
         if parts.len() > 3 {
             return Err(crate::error::HilError::invalid_parameter(
                 "query kind",

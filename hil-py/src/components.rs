@@ -21,7 +21,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use serde_json::Value;
 
-use crate::convert::{from_py, to_py};
+use crate::convert::{ContextArg, from_py, to_py};
 use crate::errors::{IntoPy, to_py_err};
 use crate::pycomponents::{
     PyChannel, PyEnvironment, PyPolicy, PyWorkload, environment_facts, policy_facts,
@@ -68,6 +68,14 @@ parse_config!(channel_config, QueryChannelConfig);
 /// [`limits::ARMS`], checked before the names are made, so `10**12` is an
 /// error) or names.
 pub(crate) fn action_space(actions: &Bound<'_, PyAny>) -> PyResult<ActionSpace> {
+    // A bool extracts as a count (True = 1 action): refuse it instead.
+    if actions.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(to_py_err(HilError::invalid_parameter(
+            "actions",
+            actions.to_string(),
+            "give a count or a list of names, not a bool",
+        )));
+    }
     let names: Vec<String> = match actions.extract::<usize>() {
         Ok(n) => {
             limits::check_count("actions", n, limits::ARMS).py_err()?;
@@ -330,6 +338,23 @@ impl PyPolicyHandle {
         wl0: f64,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        // Arrays given for a policy that will not pretrain would be
+        // silently unused.
+        let pretrains = match params
+            .map(|p| p.get_item("pretrain"))
+            .transpose()?
+            .flatten()
+        {
+            Some(v) => v.is_truthy()?,
+            None => false,
+        };
+        if pretraining.is_some() && !pretrains {
+            return Err(to_py_err(HilError::invalid_parameter(
+                "pretraining",
+                "(arrays)",
+                "given, but the policy does not pretrain: add pretrain=True",
+            )));
+        }
         let cfg = policy_config(table(r#type, params)?).py_err()?;
         let ctx = task_context(py, environment, actions, dim, pretraining, seed)?;
         let forecast = forecast.map(workload_arg).transpose()?;
@@ -373,7 +398,7 @@ impl PyPolicyHandle {
     fn decide(
         &self,
         py: Python<'_>,
-        context: &Bound<'_, PyArray1<f64>>,
+        context: ContextArg<'_>,
         t: u64,
         workload: Option<&Bound<'_, PyWorkloadHandle>>,
         wl0: Option<f64>,
@@ -382,7 +407,7 @@ impl PyPolicyHandle {
         items_seen: usize,
         attempt: u32,
     ) -> PyResult<Py<PyAny>> {
-        let x = self.context(context)?;
+        let x = self.context(&context.0)?;
         let given = query_times.map(|q| history_of(&q)).transpose()?;
         let model = workload.map(|w| w.get().inner.clone());
         let decision: Decision = py
@@ -407,13 +432,13 @@ impl PyPolicyHandle {
     fn act(
         &self,
         py: Python<'_>,
-        context: &Bound<'_, PyArray1<f64>>,
+        context: ContextArg<'_>,
         t: u64,
         item_index: usize,
         items_seen: usize,
         attempt: u32,
     ) -> PyResult<usize> {
-        let x = self.context(context)?;
+        let x = self.context(&context.0)?;
         let light = self.dim < DETACH_MIN_DIM;
         self.with_state(py, light, |s| {
             s.act(&x, t, (item_index, items_seen, attempt))
@@ -427,13 +452,13 @@ impl PyPolicyHandle {
     fn observe(
         &self,
         py: Python<'_>,
-        context: &Bound<'_, PyArray1<f64>>,
+        context: ContextArg<'_>,
         arm: usize,
         reward: f64,
         t: u64,
         from_expert: bool,
     ) -> PyResult<()> {
-        let x = self.context(context)?;
+        let x = self.context(&context.0)?;
         let attempt = Attempt {
             context: &x,
             arm: ArmId(arm),
@@ -495,11 +520,11 @@ impl PyPolicyHandle {
     #[pyo3(signature = (context, t=1, **decide_args))]
     fn diagnostics(
         slf: &Bound<'_, Self>,
-        context: &Bound<'_, PyArray1<f64>>,
+        context: ContextArg<'_>,
         t: u64,
         decide_args: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Py<PyAny>> {
-        let d = slf.call_method("decide", (context, t), decide_args)?;
+        let d = slf.call_method("decide", (context.0, t), decide_args)?;
         Ok(d.get_item("diagnostics")?.unbind())
     }
 

@@ -137,6 +137,41 @@ pub(crate) fn from_json<T: DeserializeOwned>(what: &str, json: &str) -> PyResult
         .py_err()
 }
 
+/// A context argument: a 1-d float64 NumPy array as it is (the fast path,
+/// no conversion), or anything NumPy reads as a 1-d array of numbers (a
+/// list, a float32 or int array), converted once; anything else is an
+/// error naming `context` with what was given.
+pub(crate) struct ContextArg<'py>(pub(crate) Bound<'py, PyArray1<f64>>);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for ContextArg<'py> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(a) = obj.cast::<PyArray1<f64>>() {
+            return Ok(Self(a.to_owned()));
+        }
+        let obj = obj.to_owned();
+        let refuse =
+            |why: String| crate::errors::to_py_err(HilError::invalid_input("context", why));
+        let numpy = PyModule::import(obj.py(), "numpy")?;
+        let array = numpy
+            .call_method1("asarray", (&obj, "float64"))
+            .map_err(|e| {
+                let given = obj
+                    .get_type()
+                    .name()
+                    .map(|n| n.to_string())
+                    .unwrap_or_default();
+                refuse(format!("a {given} is not a 1-d array of numbers ({e})"))
+            })?;
+        let shape = array.getattr("shape")?;
+        array
+            .cast_into::<PyArray1<f64>>()
+            .map(Self)
+            .map_err(|_| refuse(format!("must be a 1-d array, got one of shape {shape}")))
+    }
+}
+
 /// A context from a 1-d float64 array: one copy, straight into the
 /// context's shared buffer (hil's policies may keep a context, so it cannot
 /// borrow NumPy's memory), checked once by `Context::new`.

@@ -123,3 +123,38 @@ def test_a_query_kind_may_be_given_as_text():
     assert a.decide(np.ones(2))["choice"]["kind"]["response"] == "open_ended"
     with pytest.raises(hil.HilError, match="medium"):
         hil.AlwaysQuery(alpha=0.5, actions=3, dim=2, query_kind="mcq/medium")
+
+
+def test_a_context_may_be_any_1d_array_like_and_anything_else_names_context():
+    p = hil.LinUCB(alpha=1.0, actions=3, dim=4)
+    want = p.decide(np.ones(4))
+    for x in ([1, 1, 1, 1], np.ones(4, dtype=np.float32), np.ones(4, dtype=np.int64), (1.0, 1, 1, 1)):
+        assert p.decide(x) == want
+    p.observe([1, 0, 0, 0], 0, 1.0)
+    for bad in (np.ones((2, 2)), "abcd", 3.0):
+        with pytest.raises(hil.InvalidInputError) as e:
+            p.decide(bad)
+        assert "context" in str(e.value)
+
+
+def test_counts_and_indices_are_not_silently_coerced():
+    with pytest.raises(hil.InvalidParameterError) as e:
+        hil.LinUCB(alpha=1.0, actions=True, dim=4)
+    assert e.value.name == "actions"
+    with pytest.raises(TypeError):
+        hil.Act(1.9)
+    with pytest.raises(TypeError):
+        hil.Query(2.7)
+    assert hil.Act(np.int64(2))["choice"]["arm"] == 2
+    for spelling in ("", "//"):
+        with pytest.raises(hil.InvalidParameterError):
+            hil.QueryKind(spelling)
+
+
+def test_pretraining_arrays_for_a_policy_that_does_not_pretrain_are_refused():
+    X = np.ones((6, 4))
+    arms = np.arange(6) % 3
+    rewards = np.ones(6)
+    with pytest.raises(hil.InvalidParameterError) as e:
+        hil.LinUCB(alpha=1.0, actions=3, dim=4, pretraining=(X, arms, rewards))
+    assert e.value.name == "pretraining"

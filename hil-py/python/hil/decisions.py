@@ -17,6 +17,7 @@ decision; a bare arm index is a valid decision too.
 
 from __future__ import annotations
 
+import operator
 from typing import Any, Dict, Optional, Sequence, Tuple, TypedDict, Union
 
 from . import _hil
@@ -78,7 +79,7 @@ def _decision(choice: Dict[str, Any], diagnostics: Optional[Dict[str, Any]]) -> 
 
 def Act(arm: int, diagnostics: Optional[Dict[str, Any]] = None) -> DecisionDict:
     """Execute ``arm`` (an int in ``0..n_arms``)."""
-    return _decision({"type": "act", "arm": int(arm)}, diagnostics)
+    return _decision({"type": "act", "arm": operator.index(arm)}, diagnostics)
 
 
 def Query(
@@ -89,7 +90,7 @@ def Query(
     """Ask the person; ``fallback`` is executed if they decline or do not
     answer. ``kind``: a spelling (see :func:`QueryKind`) or its dict."""
     kind = QueryKind(kind) if isinstance(kind, str) else kind
-    return _decision({"type": "query", "kind": kind, "fallback": int(fallback)}, diagnostics)
+    return _decision({"type": "query", "kind": kind, "fallback": operator.index(fallback)}, diagnostics)
 
 
 # What a policy's decide may return (for type hints).

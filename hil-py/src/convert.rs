@@ -122,6 +122,16 @@ fn value_at(obj: &Bound<'_, PyAny>, what: &str, depth: usize) -> PyResult<Value>
     ))
 }
 
+/// Plain Python data as JSON text, for the package's own Python code to
+/// hand a dict to a function that takes JSON: a NaN or infinite float
+/// anywhere is an `InvalidInputError` naming its key (`what.session.wl0`),
+/// where `json.dumps` would write a bare `NaN` that fails to parse at a
+/// column.
+#[pyfunction]
+pub(crate) fn plain_json(value: &Bound<'_, PyAny>, what: &str) -> PyResult<String> {
+    to_json(what, &to_value(value, what)?)
+}
+
 /// `value` as JSON text (what crosses to Python as a plain string, e.g.
 /// between `hil.sweep`'s processes); an error names `what`.
 pub(crate) fn to_json<T: Serialize + ?Sized>(what: &str, value: &T) -> PyResult<String> {

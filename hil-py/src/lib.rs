@@ -61,6 +61,7 @@ fn _hil(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // The UCB weight α of the paper's methods (hil's choice; the paper does not state it).
     m.add("PAPER_ALPHA", hil_paper::methods::ALPHA)?;
     errors::register(m)?;
+    m.add_function(wrap_pyfunction!(convert::plain_json, m)?)?;
     components::register(m)?;
     registry::register_module(m)?;
     session::register(m)?;

@@ -158,3 +158,10 @@ def test_pretraining_arrays_for_a_policy_that_does_not_pretrain_are_refused():
     with pytest.raises(hil.InvalidParameterError) as e:
         hil.LinUCB(alpha=1.0, actions=3, dim=4, pretraining=(X, arms, rewards))
     assert e.value.name == "pretraining"
+
+
+def test_a_nan_in_an_environment_dict_names_its_key():
+    envs = pytest.importorskip("hil.envs")
+    with pytest.raises(hil.InvalidInputError) as e:
+        envs.FoodReplayEnv(session={"wl0": float("nan")})
+    assert "config.session.wl0" in str(e.value)

@@ -151,7 +151,7 @@ class HilEnv(gym.Env):
         }
         if query_kind is not None:
             config["query_kind"] = query_kind
-        self.core = _hil.GymCore(json.dumps(config), base_dir)
+        self.core = _hil.GymCore(_hil.plain_json(config, "config"), base_dir)
         self.workload_weight = float(workload_weight)
         self.wl0 = float(config["session"].get("wl0", 0.5))
         self.n_arms: int = self.core.n_arms
@@ -216,7 +216,7 @@ class HilEnv(gym.Env):
                 obs, reward, done, _, info = env.step(env.act(qg))
                 env.learn(qg)
         """
-        return self.core.policy(json.dumps(config))
+        return self.core.policy(_hil.plain_json(config, "policy"))
 
     def act(self, policy: _hil.Policy) -> int:
         """``policy``'s action at the pending decision (an arm, or

@@ -211,7 +211,7 @@ def _reporter(progress, what: str):
 
 def _sweep_protocol(settings: dict, components: dict, ray, tasks_per_cpu: int, progress) -> dict:
     settings_json, registrations = _hil.protocol_with_components(
-        json.dumps(settings), **components
+        _hil.plain_json(settings, "settings"), **components
     )
     settings = json.loads(settings_json)
     if ray is None:

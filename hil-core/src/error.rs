@@ -77,8 +77,10 @@ pub enum HilError {
         /// What is wrong with it.
         why: String,
     },
-    /// (De)serialising state or parameters failed.
-    #[error("serialisation of {what} failed: {source}")]
+    /// (De)serialising state or parameters failed: almost always reading
+    /// one that is malformed (a missing field, a wrong type), so the
+    /// message says what was invalid, not which direction failed.
+    #[error("invalid {what}: {source}")]
     Serde {
         /// What was being (de)serialised.
         what: String,

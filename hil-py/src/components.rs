@@ -284,11 +284,12 @@ pub(crate) fn task_context(
     match pretraining {
         None => Ok(task),
         Some(p) => {
+            let (x, arms, rewards) = pretraining_arrays(py, p)?;
             let (x, arms, rewards): (
                 PyReadonlyArray2<'_, f64>,
                 PyReadonlyArray1<'_, i64>,
                 PyReadonlyArray1<'_, f64>,
-            ) = p.extract()?;
+            ) = (x.extract()?, arms.extract()?, rewards.extract()?);
             let (x, arms, rewards) = (x.as_array(), arms.as_array(), rewards.as_array());
             if x.nrows() != arms.len() || x.nrows() != rewards.len() {
                 return Err(to_py_err(HilError::invalid_input(
@@ -309,16 +310,71 @@ pub(crate) fn task_context(
                         format!("{} is negative", arms[i]),
                     ))
                 })?;
+                let context = Context::new(row.to_vec())
+                    .map_err(|e| {
+                        HilError::invalid_input(format!("pretraining X[{i}]"), e.to_string())
+                    })
+                    .py_err()?;
                 data.push(LabelledObservation {
-                    context: Context::new(row.to_vec()).py_err()?,
+                    context,
                     arm: ArmId(arm),
                     reward: rewards[i],
                 });
             }
-            let _ = py;
             Ok(task.with_pretraining(data.into()))
         }
     }
+}
+
+/// `pretraining=(X, arms, rewards)` as NumPy arrays of the types the
+/// policy reads (X float64 n × d, arms int64, rewards float64), converted
+/// from any array-like (a list, float32, int32), each error naming the
+/// part at fault. Arms must be whole numbers: 0.5 is refused, never
+/// truncated.
+fn pretraining_arrays<'py>(
+    py: Python<'py>,
+    p: &Bound<'py, PyAny>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let refuse = |what: &str, why: String| {
+        to_py_err(HilError::invalid_input(format!("pretraining {what}"), why))
+    };
+    let (x, arms, rewards): (Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>) = p
+        .extract()
+        .map_err(|_| refuse("", "expected a tuple (X, arms, rewards) of arrays".into()))?;
+    let numpy = PyModule::import(py, "numpy")?;
+    let array = |v: &Bound<'py, PyAny>, what: &str, ndim: usize| -> PyResult<Bound<'py, PyAny>> {
+        let a = numpy
+            .call_method1("asarray", (v,))
+            .map_err(|e| refuse(what, format!("not an array ({e})")))?;
+        let shape = a.getattr("shape")?;
+        if a.getattr("ndim")?.extract::<usize>()? != ndim {
+            return Err(refuse(what, format!("must be {ndim}-d, got shape {shape}")));
+        }
+        Ok(a)
+    };
+    let kind = |a: &Bound<'py, PyAny>| -> PyResult<String> {
+        a.getattr("dtype")?.getattr("kind")?.extract()
+    };
+    let float = |v: &Bound<'py, PyAny>, what: &str, ndim: usize| -> PyResult<Bound<'py, PyAny>> {
+        let a = array(v, what, ndim)?;
+        if !"fiub".contains(kind(&a)?.as_str()) {
+            return Err(refuse(
+                what,
+                format!("must hold numbers, not {}", a.getattr("dtype")?),
+            ));
+        }
+        a.call_method1("astype", ("float64",))
+    };
+    let x = float(&x, "X", 2)?;
+    let rewards = float(&rewards, "rewards", 1)?;
+    let arms = array(&arms, "arms", 1)?;
+    if !"iu".contains(kind(&arms)?.as_str()) {
+        return Err(refuse(
+            "arms",
+            format!("must hold whole numbers, not {}", arms.getattr("dtype")?),
+        ));
+    }
+    Ok((x, arms.call_method1("astype", ("int64",))?, rewards))
 }
 
 #[pymethods]

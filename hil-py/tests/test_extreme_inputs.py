@@ -165,3 +165,30 @@ def test_a_nan_in_an_environment_dict_names_its_key():
     with pytest.raises(hil.InvalidInputError) as e:
         envs.FoodReplayEnv(session={"wl0": float("nan")})
     assert "config.session.wl0" in str(e.value)
+
+
+def test_pretraining_arrays_of_other_types_convert_or_name_the_part():
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(12, 4)).astype(np.float32).astype(np.float64)  # exact in float32
+    arms = np.arange(12) % 3
+    rewards = (arms == 1).astype(float)
+    want = hil.LinUCB(alpha=1.0, actions=3, dim=4, pretrain=True, pretraining=(X, arms, rewards))
+    for given in [
+        (X.astype(np.float32), arms.astype(np.int32), rewards.tolist()),
+        (X.tolist(), arms.tolist(), rewards.astype(np.float32)),
+    ]:
+        got = hil.LinUCB(alpha=1.0, actions=3, dim=4, pretrain=True, pretraining=given)
+        assert got.diagnostics(X[0]) == want.diagnostics(X[0])
+    bad = [
+        ((X, arms + 0.5, rewards), "arms"),
+        ((X[0], arms, rewards), "X"),
+        ((X, arms, np.array(["a"] * 12)), "rewards"),
+        ((X, arms), "tuple"),
+    ]
+    for given, part in bad:
+        with pytest.raises(hil.InvalidInputError) as e:
+            hil.LinUCB(alpha=1.0, actions=3, dim=4, pretrain=True, pretraining=given)
+        assert part in str(e.value)
+    X[5, 2] = np.nan
+    with pytest.raises(hil.HilError, match=r"X\[5\]"):
+        hil.LinUCB(alpha=1.0, actions=3, dim=4, pretrain=True, pretraining=(X, arms, rewards))

@@ -12,7 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{to_py, to_toml};
-use crate::errors::IntoPy;
+use crate::errors::{IntoPy, to_py_err};
 
 /// Runs the user-study protocol and returns its results.
 ///
@@ -29,7 +29,7 @@ use crate::errors::IntoPy;
 ///
 /// Runs with the GIL released.
 #[pyfunction]
-#[pyo3(signature = (study=None, *, environment=None, seed=None, repetitions=None, n_att=None, seeds=None, threads=0))]
+#[pyo3(signature = (study=None, *, environment=None, seed=None, repetitions=None, n_att=None, seeds=None, threads=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn user_study(
     py: Python<'_>,
@@ -39,8 +39,16 @@ pub(crate) fn user_study(
     repetitions: Option<usize>,
     n_att: Option<u32>,
     seeds: Option<usize>,
-    threads: usize,
+    threads: Option<usize>,
 ) -> PyResult<Py<PyAny>> {
+    // One study runs on one thread: `threads` alone would be ignored.
+    if let (None, Some(t)) = (seeds, threads) {
+        return Err(to_py_err(HilError::invalid_parameter(
+            "threads",
+            t,
+            "threads go with seeds= (the study over several seeds runs in parallel)",
+        )));
+    }
     let (mut cfg, base) = study_of(study, environment)?;
     if let Some(s) = seed {
         cfg.seed = s;
@@ -58,7 +66,7 @@ pub(crate) fn user_study(
             to_py(py, &result, "user study")
         }
         Some(n) => {
-            let runner = Runner::new(threads).py_err()?;
+            let runner = Runner::new(threads.unwrap_or(0)).py_err()?;
             let seeds = hil_config::limits::consecutive_seeds("seeds", cfg.seed, n).py_err()?;
             let over = py
                 .detach(|| cfg.run_over_seeds(&base, &seeds, &runner, &|_| {}))

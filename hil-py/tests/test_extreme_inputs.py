@@ -192,3 +192,9 @@ def test_pretraining_arrays_of_other_types_convert_or_name_the_part():
     X[5, 2] = np.nan
     with pytest.raises(hil.HilError, match=r"X\[5\]"):
         hil.LinUCB(alpha=1.0, actions=3, dim=4, pretrain=True, pretraining=(X, arms, rewards))
+
+
+def test_user_study_threads_without_seeds_is_refused_not_ignored():
+    with pytest.raises(hil.InvalidParameterError) as e:
+        hil.user_study(threads=10**6)
+    assert e.value.name == "threads"

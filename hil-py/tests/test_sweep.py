@@ -71,6 +71,14 @@ def test_bad_inputs_are_refused(tmp_path):
         sweep()
     with pytest.raises(ValueError):
         sweep("quick", backend="spark")
+    # Were silently replaced (max(1, ...), every core) or returned [].
+    for kwargs in ({"tasks_per_cpu": -5}, {"tasks_per_cpu": 0}, {"num_cpus": 0}):
+        with pytest.raises(ValueError, match=next(iter(kwargs))):
+            sweep("quick", backend="local", **kwargs)
+    with pytest.raises(ValueError, match="at least one"):
+        sweep(configs=[CONFIG], seeds=[], backend="local")
+    with pytest.raises(TypeError):
+        sweep("quick", backend="local", tasks_per_cpu=2.5)
 
 
 @pytest.mark.parametrize("backend", ["auto", "ray"])

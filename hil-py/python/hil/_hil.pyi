@@ -303,7 +303,7 @@ def user_study(
     repetitions: Optional[int] = None,
     n_att: Optional[int] = None,
     seeds: Optional[int] = None,
-    threads: int = 0,
+    threads: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 
 # --- conformance suites (hil.testing) --------------------------------------------

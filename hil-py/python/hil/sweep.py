@@ -16,6 +16,7 @@ published figures: results are not the paper's.
 from __future__ import annotations
 
 import json
+import operator
 import os
 from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
@@ -173,6 +174,13 @@ def sweep(
     """
     if (protocol is None) == (configs is None):
         raise ValueError("give either protocol or configs (with seeds)")
+    # Checked here, before Ray starts: none of them is silently replaced.
+    if isinstance(tasks_per_cpu, bool) or operator.index(tasks_per_cpu) < 1:
+        raise ValueError(f"tasks_per_cpu must be a whole number >= 1, got {tasks_per_cpu!r}")
+    if num_cpus is not None and (isinstance(num_cpus, bool) or operator.index(num_cpus) < 1):
+        raise ValueError(f"num_cpus must be a whole number >= 1 (or None for every core), got {num_cpus!r}")
+    if configs is not None and (len(configs) == 0 or (seeds is not None and len(seeds) == 0)):
+        raise ValueError("a config grid needs at least one config and one seed")
     ray = _ray(backend, address)
     if ray is not None:
         _start_ray(ray, address, num_cpus)

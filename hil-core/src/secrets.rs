@@ -36,7 +36,9 @@ pub fn read_private(path: &Path, limit: u64) -> Result<String> {
         use std::os::unix::fs::PermissionsExt;
         let meta = std::fs::metadata(path).map_err(|e| HilError::io("reading", path, e))?;
         let mode = meta.permissions().mode() & 0o777;
-        if mode & 0o077 != 0 {
+        // Not a file (a directory, a FIFO): read_text says so below, which
+        // a complaint about its mode would hide.
+        if meta.is_file() && mode & 0o077 != 0 {
             return Err(HilError::io(
                 "reading",
                 path,

@@ -81,11 +81,12 @@ pub fn check_disjoint(sets: &[(&str, &[String])], ds: &FoodDataset) -> Result<()
                 ));
             }
             if let Some((other, _)) = seen.iter().find(|(_, g)| g == f) {
-                return Err(HilError::invalid_parameter(
-                    *set,
-                    f,
-                    format!("the food is also in `{other}`; a food may be in one list only"),
-                ));
+                let why = if other == set {
+                    format!("the food is named twice in `{set}`")
+                } else {
+                    format!("the food is also in `{other}`; a food may be in one list only")
+                };
+                return Err(HilError::invalid_parameter(*set, f, why));
             }
             seen.push((set, f));
         }

@@ -128,6 +128,10 @@ fn a_key_file_others_may_read_is_refused() {
     assert!(e.contains("chmod 600"), "{e}");
     // Nothing was recorded under a key that is not private.
     assert!(!log.exists());
+    // A directory given as the key is named as one, not asked to be chmod'ed.
+    let e = refused(&keyed_run("", &config, &log, &dir));
+    assert!(e.contains("a directory"), "{e}");
+    assert!(!e.contains("chmod"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -146,6 +146,12 @@ fn splits_reject_unknown_empty_and_shared_foods() {
     s.test.push("apple".into());
     let e = s.validate(&ds).unwrap_err().to_string();
     assert!(e.contains("apple") && e.contains("split.pretrain"), "{e}");
+    // Twice in one list is said as such, not as "also in" that list.
+    let mut s = FoodSplit::paper();
+    let first = s.test[0].clone();
+    s.test.push(first);
+    let e = s.validate(&ds).unwrap_err().to_string();
+    assert!(e.contains("named twice in `split.test`"), "{e}");
 }
 
 #[test]

@@ -33,16 +33,23 @@ impl Threads {
     /// The runner of this many threads; past
     /// [`hil_jobs::MAX_THREADS`], an error naming `--threads`.
     pub fn runner(self) -> hil_core::Result<hil_jobs::Runner> {
-        hil_jobs::Runner::new(self.threads).map_err(|e| match e {
-            hil_core::HilError::InvalidParameter { value, why, .. } => {
-                hil_core::HilError::InvalidParameter {
-                    name: "--threads".into(),
-                    value,
-                    why,
-                }
+        hil_jobs::Runner::new(self.threads).map_err(|e| as_flag(e, |_| "--threads".into()))
+    }
+}
+
+/// A library's [`InvalidParameter`](hil_core::HilError::InvalidParameter)
+/// error renamed to the flag that set it (`flag(name)`), so the message
+/// names what the user typed; other errors pass through.
+pub fn as_flag(e: hil_core::HilError, flag: impl FnOnce(&str) -> String) -> hil_core::HilError {
+    match e {
+        hil_core::HilError::InvalidParameter { name, value, why } => {
+            hil_core::HilError::InvalidParameter {
+                name: flag(&name),
+                value,
+                why,
             }
-            other => other,
-        })
+        }
+        other => other,
     }
 }
 

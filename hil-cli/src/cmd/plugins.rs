@@ -134,20 +134,11 @@ fn options(
         })?;
         opts = opts.with_actions(space);
     }
-    opts.validate().map_err(|e| match e {
-        HilError::InvalidParameter { name, value, why } => HilError::InvalidParameter {
-            name: format!(
-                "--{}",
-                if name == "context_dim" {
-                    "dim"
-                } else {
-                    name.as_str()
-                }
-            ),
-            value,
-            why,
-        },
-        other => other,
+    opts.validate().map_err(|e| {
+        super::as_flag(e, |name| match name {
+            "context_dim" => "--dim".into(),
+            other => format!("--{other}"),
+        })
     })?;
     Ok(opts)
 }
